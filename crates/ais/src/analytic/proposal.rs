@@ -1,0 +1,50 @@
+//! Proposal samplers for the analytic scenes.
+
+use glam::DVec3;
+use std::f64::consts::PI;
+
+/// A proposal distribution over directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Proposal {
+    /// Uniform over the whole sphere: half of its candidates fall outside a diffuse BSDF's
+    /// support, which exercises unconditional rejection.
+    UniformSphere,
+    /// Cosine-weighted over the upper hemisphere (BSDF sampling for a diffuse surface).
+    CosineHemisphere,
+}
+
+impl Proposal {
+    /// Maps `u` ∈ [0, 1)² to a unit direction and its density (per steradian).
+    pub fn sample(self, u: [f32; 2]) -> (DVec3, f64) {
+        let (u1, u2) = (u[0] as f64, u[1] as f64);
+        let phi = 2.0 * PI * u2;
+        match self {
+            Proposal::UniformSphere => {
+                let z = 1.0 - 2.0 * u1;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                (DVec3::new(r * phi.cos(), r * phi.sin(), z), 0.25 / PI)
+            }
+            Proposal::CosineHemisphere => {
+                let r = u1.sqrt();
+                let z = (1.0 - u1).max(0.0).sqrt();
+                (DVec3::new(r * phi.cos(), r * phi.sin(), z), z / PI)
+            }
+        }
+    }
+
+    /// Density of a unit direction.
+    pub fn pdf(self, direction: DVec3) -> f64 {
+        match self {
+            Proposal::UniformSphere => 0.25 / PI,
+            Proposal::CosineHemisphere => direction.z.max(0.0) / PI,
+        }
+    }
+
+    /// A short name for tables.
+    pub fn name(self) -> &'static str {
+        match self {
+            Proposal::UniformSphere => "uniform",
+            Proposal::CosineHemisphere => "cosine",
+        }
+    }
+}

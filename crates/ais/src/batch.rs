@@ -1,0 +1,497 @@
+//! The batch driver: candidate placement, acceptance, the unbiased n+1 stopping rule and the
+//! estimator. The host traces rays; the batch decides which ones.
+//!
+//! ```
+//! use ais::{Batch, BatchConfig, Decision, MapStart, rating};
+//! use glam::Vec3;
+//!
+//! let mut batch: Batch<f32> = Batch::new(BatchConfig::default()).unwrap();
+//! batch.begin(16, 7, MapStart::Empty);
+//! while let Some(candidate) = batch.next_candidate() {
+//!     // The host's proposal: here, uniform over the upper hemisphere (pdf 1/2π).
+//!     let z = candidate.u[0];
+//!     let phi = std::f32::consts::TAU * candidate.u[1];
+//!     let r = (1.0 - z * z).sqrt();
+//!     let direction = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+//!     match batch.decide(direction, true) {
+//!         Decision::Reject(_) => continue,
+//!         Decision::Trace { .. } => {
+//!             let visible = direction.x > 0.0; // the host's ray query
+//!             let radiance = if visible { 1.0 } else { 0.0 };
+//!             let pdf = 1.0 / std::f32::consts::TAU;
+//!             batch.record(radiance * z / std::f32::consts::PI / pdf, rating(radiance, 1.0));
+//!         }
+//!     }
+//! }
+//! let estimate = batch.finish();
+//! assert!(estimate.value > 0.0 && estimate.traced == 16);
+//! ```
+
+use crate::affinity_map::{AffinityMap, Lookup, MapConfig, MapConfigError};
+use crate::epochs::EpochPlan;
+use crate::halton::ScrambledHalton;
+use crate::rng::Pcg32;
+use crate::stats::Stats;
+use crate::value::Value;
+use glam::Vec3;
+
+/// When the affinity map learns during a batch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Learning {
+    /// The talk's rule: every traced ray updates the map at once. Not exactly unbiased, since
+    /// acceptance probabilities change inside the batch (see BENCHMARKS.md for the measured bias).
+    Continuous,
+    /// Frozen-map epochs (see [`crate::epochs`]): exactly unbiased. `epochs` is the number of
+    /// doubling epochs, e.g. 4 gives `n/8, n/8, n/4, n/2`.
+    Epochs {
+        /// Number of epochs (1..=[`crate::epochs::MAX_EPOCHS`]).
+        epochs: u32,
+    },
+    /// The map is used but never updated (a fixed map, e.g. learned elsewhere): exactly unbiased.
+    Off,
+}
+
+/// Where candidates' random numbers come from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// The 3-D Halton sequence, scrambled per batch (the talk's choice).
+    Halton,
+    /// Independent uniform random numbers (the talk's "simple random" comparison).
+    Random,
+}
+
+/// When a batch (or epoch) stops.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stopping {
+    /// Draw until `n + 1` candidates are accepted, drop the last one untraced, and divide by
+    /// the number of candidates before it: unbiased for a fixed acceptance probability.
+    DropLast,
+    /// Stop at the `n`-th accepted candidate. Biased toward high-affinity directions (the
+    /// talk's "families until n boys"); offered only to measure that bias.
+    AtN,
+}
+
+/// Everything that configures a batch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BatchConfig {
+    /// The affinity map, or `None` for AIS off (every in-support candidate is traced).
+    pub affinity: Option<MapConfig>,
+    /// When the map learns.
+    pub learning: Learning,
+    /// Halton or random placement.
+    pub placement: Placement,
+    /// The stopping rule.
+    pub stopping: Stopping,
+    /// An epoch of `n_e` rays stops after at most `candidate_cap * n_e` candidates (at least 1).
+    /// An epoch ended by the cap averages all its candidates; with a fixed map this is still
+    /// exactly unbiased (the inverse-hypergeometric argument), and it is counted in
+    /// [`Stats::cap_hits`].
+    pub candidate_cap: u32,
+}
+
+impl Default for BatchConfig {
+    /// The defaults chosen from the study in BENCHMARKS.md.
+    fn default() -> Self {
+        BatchConfig {
+            affinity: Some(MapConfig::default()),
+            learning: Learning::Epochs { epochs: 4 },
+            placement: Placement::Halton,
+            stopping: Stopping::DropLast,
+            candidate_cap: 64,
+        }
+    }
+}
+
+impl BatchConfig {
+    /// AIS off: a plain batch of `n` traced rays (the baseline every mode is compared with).
+    pub fn off() -> Self {
+        BatchConfig {
+            affinity: None,
+            learning: Learning::Off,
+            ..BatchConfig::default()
+        }
+    }
+}
+
+/// How a batch starts its map.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapStart {
+    /// An empty map (affinity 1 everywhere), as in the talk.
+    Empty,
+    /// The map as it is now: what the previous batch left, or what the host wrote with
+    /// [`Batch::map_mut`] (warm start; with [`Learning::Off`], a fixed map).
+    Current,
+}
+
+/// A candidate's random numbers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Candidate {
+    /// Index of the candidate in the batch (also its Halton index).
+    pub index: u32,
+    /// The two numbers for the host's proposal sampler, in [0, 1)².
+    pub u: [f32; 2],
+}
+
+/// Why a candidate was not traced.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RejectReason {
+    /// Outside the BSDF's support: a known zero.
+    OutsideSupport,
+    /// Rejected by Russian roulette against the affinity map.
+    Roulette,
+    /// The (n_e + 1)-th accepted candidate of an epoch: dropped untraced.
+    Dropped,
+}
+
+/// What the host should do with a candidate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Decision {
+    /// Do not trace; go on to the next candidate.
+    Reject(RejectReason),
+    /// Trace the ray, then call [`Batch::record`]. `weight` = 1 / affinity is applied by the
+    /// batch itself; it is given for hosts that want to display it.
+    Trace {
+        /// 1 / affinity.
+        weight: f32,
+    },
+}
+
+/// The result of a batch.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimate<V> {
+    /// The unbiased estimate of the gathered integral.
+    pub value: V,
+    /// Candidates counted by the estimator.
+    pub candidates: u32,
+    /// Rays traced.
+    pub traced: u32,
+    /// Whether any epoch ended at the candidate cap.
+    pub hit_cap: bool,
+}
+
+/// A traced candidate waiting for its [`Batch::record`].
+#[derive(Clone, Copy, Debug)]
+struct Pending {
+    lookup: Option<Lookup>,
+    affinity: f32,
+}
+
+/// A recorded ray held back until its epoch ends.
+#[derive(Clone, Copy, Debug)]
+struct DeferredUpdate {
+    lookup: Lookup,
+    rating: f32,
+    accepted_with: f32,
+}
+
+/// Why a [`BatchConfig`] was refused.
+#[derive(Clone, Debug, PartialEq)]
+pub enum BatchConfigError {
+    /// The affinity map configuration is invalid.
+    Map(MapConfigError),
+    /// The candidate cap is 0.
+    ZeroCandidateCap,
+    /// The epoch count is 0 or above [`crate::epochs::MAX_EPOCHS`].
+    BadEpochCount(u32),
+}
+
+impl std::fmt::Display for BatchConfigError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            BatchConfigError::Map(e) => e.fmt(f),
+            BatchConfigError::ZeroCandidateCap => write!(f, "candidate cap must be at least 1"),
+            BatchConfigError::BadEpochCount(n) => write!(
+                f,
+                "epoch count {n} is invalid: it must be 1..={}",
+                crate::epochs::MAX_EPOCHS
+            ),
+        }
+    }
+}
+
+impl std::error::Error for BatchConfigError {}
+
+/// A reusable batch driver with its affinity map. One per thread; allocation-free per batch
+/// once it has seen its largest `n`.
+#[derive(Clone, Debug)]
+pub struct Batch<V: Value> {
+    config: BatchConfig,
+    map: Option<AffinityMap>,
+    halton: ScrambledHalton,
+    rng: Pcg32,
+    deferred: Vec<DeferredUpdate>,
+    plan: EpochPlan,
+    n: u32,
+    epoch: usize,
+    epoch_candidates: u32,
+    epoch_accepted: u32,
+    epoch_sum: V,
+    total: V,
+    next_index: u32,
+    /// The current candidate's acceptance number u3.
+    acceptance: f32,
+    pending: Option<Pending>,
+    done: bool,
+    batch_stats: Stats,
+    stats: Stats,
+}
+
+impl<V: Value> Batch<V> {
+    /// A batch driver; allocates its map once.
+    pub fn new(config: BatchConfig) -> Result<Self, BatchConfigError> {
+        if config.candidate_cap == 0 {
+            return Err(BatchConfigError::ZeroCandidateCap);
+        }
+        if let Learning::Epochs { epochs } = config.learning {
+            if epochs == 0 || epochs as usize > crate::epochs::MAX_EPOCHS {
+                return Err(BatchConfigError::BadEpochCount(epochs));
+            }
+        }
+        let map = config
+            .affinity
+            .map(AffinityMap::new)
+            .transpose()
+            .map_err(BatchConfigError::Map)?;
+        Ok(Batch {
+            config,
+            map,
+            halton: ScrambledHalton::unscrambled(),
+            rng: Pcg32::new(0, 0),
+            deferred: Vec::new(),
+            plan: EpochPlan::single(1),
+            n: 0,
+            epoch: 0,
+            epoch_candidates: 0,
+            epoch_accepted: 0,
+            epoch_sum: V::zero(),
+            total: V::zero(),
+            next_index: 0,
+            acceptance: 0.0,
+            pending: None,
+            done: true,
+            batch_stats: Stats::default(),
+            stats: Stats::default(),
+        })
+    }
+
+    /// The configuration.
+    pub fn config(&self) -> &BatchConfig {
+        &self.config
+    }
+
+    /// The affinity map (`None` when AIS is off).
+    pub fn map(&self) -> Option<&AffinityMap> {
+        self.map.as_ref()
+    }
+
+    /// The affinity map, for a host that loads a learned map before [`MapStart::Current`].
+    pub fn map_mut(&mut self) -> Option<&mut AffinityMap> {
+        self.map.as_mut()
+    }
+
+    /// Counts over every batch finished so far.
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    /// Counts of the current (or last) batch.
+    pub fn batch_stats(&self) -> &Stats {
+        &self.batch_stats
+    }
+
+    /// Starts a batch of `n` traced rays (`n >= 1`) with scrambling seed `seed`.
+    ///
+    /// # Panics
+    /// If `n` is 0.
+    pub fn begin(&mut self, n: u32, seed: u64, start: MapStart) {
+        assert!(n >= 1, "a batch needs at least one ray");
+        if start == MapStart::Empty {
+            if let Some(map) = self.map.as_mut() {
+                map.clear();
+            }
+        }
+        match self.config.placement {
+            Placement::Halton => self.halton.rescramble(seed),
+            Placement::Random => self.rng = Pcg32::new(seed, 0x5241_4e44), // stream "RAND"
+        }
+        self.plan = match self.config.learning {
+            Learning::Epochs { epochs } if self.map.is_some() => EpochPlan::doubling(n, epochs),
+            _ => EpochPlan::single(n),
+        };
+        if self.deferred.capacity() < n as usize {
+            self.deferred.reserve(n as usize);
+        }
+        self.deferred.clear();
+        self.n = n;
+        self.epoch = 0;
+        self.epoch_candidates = 0;
+        self.epoch_accepted = 0;
+        self.epoch_sum = V::zero();
+        self.total = V::zero();
+        self.next_index = 0;
+        self.pending = None;
+        self.done = false;
+        self.batch_stats = Stats {
+            batches: 1,
+            ..Stats::default()
+        };
+    }
+
+    /// The next candidate, or `None` when the batch is complete.
+    ///
+    /// # Panics
+    /// If the previous candidate was accepted for tracing but not recorded.
+    pub fn next_candidate(&mut self) -> Option<Candidate> {
+        assert!(
+            self.pending.is_none(),
+            "Batch::record must follow a Decision::Trace before the next candidate"
+        );
+        if !self.done && self.epoch_candidates >= self.epoch_cap() {
+            self.batch_stats.cap_hits += 1;
+            self.close_epoch();
+        }
+        if self.done {
+            return None;
+        }
+        let index = self.next_index;
+        self.next_index += 1;
+        let [u1, u2, u3] = match self.config.placement {
+            Placement::Halton => self.halton.point(index),
+            Placement::Random => [
+                self.rng.next_f32(),
+                self.rng.next_f32(),
+                self.rng.next_f32(),
+            ],
+        };
+        self.acceptance = u3;
+        Some(Candidate { index, u: [u1, u2] })
+    }
+
+    fn epoch_cap(&self) -> u32 {
+        self.config
+            .candidate_cap
+            .saturating_mul(self.plan.sizes()[self.epoch])
+    }
+
+    /// Decides whether the current candidate, in `direction` (unit, in the map's frame), is
+    /// traced. `in_support` is false for directions outside the BSDF's support.
+    pub fn decide(&mut self, direction: Vec3, in_support: bool) -> Decision {
+        debug_assert!(!self.done, "decide called on a finished batch");
+        self.epoch_candidates += 1;
+        self.batch_stats.candidates += 1;
+        if !in_support {
+            self.batch_stats.rejected_outside_support += 1;
+            return Decision::Reject(RejectReason::OutsideSupport);
+        }
+        let lookup = self.map.as_ref().map(|map| map.lookup(direction));
+        let affinity = lookup.map_or(1.0, |l| l.affinity);
+        if self.acceptance >= affinity {
+            self.batch_stats.rejected_roulette += 1;
+            return Decision::Reject(RejectReason::Roulette);
+        }
+        let target = self.plan.sizes()[self.epoch];
+        if self.config.stopping == Stopping::DropLast && self.epoch_accepted == target {
+            // The (n_e + 1)-th acceptance: not traced and not counted.
+            self.epoch_candidates -= 1;
+            self.batch_stats.candidates -= 1;
+            self.batch_stats.dropped += 1;
+            self.close_epoch();
+            return Decision::Reject(RejectReason::Dropped);
+        }
+        self.epoch_accepted += 1;
+        self.pending = Some(Pending { lookup, affinity });
+        Decision::Trace {
+            weight: 1.0 / affinity,
+        }
+    }
+
+    /// Records what the traced ray of the current candidate saw.
+    ///
+    /// `contribution` is the plain Monte Carlo value `f(w) · visibility / p(w)` (the batch
+    /// applies the 1/affinity weight itself); `rating` ∈ [0, 1] is actual over unoccluded
+    /// radiance (see [`rating`]).
+    ///
+    /// # Panics
+    /// If the current candidate was not accepted for tracing.
+    pub fn record(&mut self, contribution: V, rating: f32) {
+        let pending = self
+            .pending
+            .take()
+            .expect("Batch::record called without a Decision::Trace");
+        self.batch_stats.traced += 1;
+        self.epoch_sum = self
+            .epoch_sum
+            .add(contribution.scale(1.0 / pending.affinity as f64));
+        if let (Some(map), Some(lookup)) = (self.map.as_mut(), pending.lookup) {
+            let rating = rating.clamp(0.0, 1.0);
+            match self.config.learning {
+                Learning::Continuous => {
+                    let outcome = map.record(&lookup, rating, pending.affinity);
+                    self.batch_stats.resets += outcome.resets as u64;
+                }
+                Learning::Epochs { .. } => self.deferred.push(DeferredUpdate {
+                    lookup,
+                    rating,
+                    accepted_with: pending.affinity,
+                }),
+                Learning::Off => {}
+            }
+        }
+        let target = self.plan.sizes()[self.epoch];
+        if self.config.stopping == Stopping::AtN && self.epoch_accepted == target {
+            self.close_epoch();
+        }
+    }
+
+    /// Ends the current epoch: adds its estimate with weight `n_e / n`, applies deferred map
+    /// updates, and moves on (or completes the batch).
+    fn close_epoch(&mut self) {
+        let size = self.plan.sizes()[self.epoch];
+        if self.epoch_candidates > 0 {
+            let weight = size as f64 / self.n as f64 / self.epoch_candidates as f64;
+            self.total = self.total.add(self.epoch_sum.scale(weight));
+        }
+        if let Some(map) = self.map.as_mut() {
+            for update in self.deferred.drain(..) {
+                let outcome = map.record(&update.lookup, update.rating, update.accepted_with);
+                self.batch_stats.resets += outcome.resets as u64;
+            }
+        }
+        self.epoch += 1;
+        self.epoch_candidates = 0;
+        self.epoch_accepted = 0;
+        self.epoch_sum = V::zero();
+        if self.epoch == self.plan.sizes().len() {
+            self.done = true;
+        }
+    }
+
+    /// The estimate of the finished batch; adds its counts to [`Batch::stats`].
+    ///
+    /// # Panics
+    /// If the batch is not complete ([`Batch::next_candidate`] has not returned `None`).
+    pub fn finish(&mut self) -> Estimate<V> {
+        assert!(
+            self.done && self.pending.is_none(),
+            "Batch::finish called before next_candidate returned None"
+        );
+        self.stats.merge(&self.batch_stats);
+        Estimate {
+            value: self.total,
+            candidates: self.batch_stats.candidates as u32,
+            traced: self.batch_stats.traced as u32,
+            hit_cap: self.batch_stats.cap_hits > 0,
+        }
+    }
+}
+
+/// The rating of a traced ray: actual over unoccluded radiance (luminance), clamped to
+/// [0, 1]; 1 when the unoccluded radiance is 0, since such a ray says nothing about occlusion.
+#[inline]
+pub fn rating(actual: f32, unoccluded: f32) -> f32 {
+    if unoccluded > 0.0 {
+        (actual / unoccluded).clamp(0.0, 1.0)
+    } else {
+        1.0
+    }
+}
