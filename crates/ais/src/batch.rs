@@ -63,9 +63,21 @@ pub enum Placement {
 /// When a batch (or epoch) stops.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Stopping {
-    /// Draw until `n + 1` candidates are accepted, drop the last one untraced, and divide by
-    /// the number of candidates before it: unbiased for a fixed acceptance probability.
+    /// The talk's rule: draw until `n + 1` candidates are accepted, drop the last one
+    /// untraced, and divide by the number of candidates before it. Unbiased for independent
+    /// candidates and a fixed acceptance probability, i.e. with [`Placement::Random`]. With
+    /// Halton placement the stopping time depends on correlated points and the estimate is
+    /// biased low (measured in BENCHMARKS.md: about −4% at n = 8 even for a fixed map).
     DropLast,
+    /// Our rule for stratified placement: every epoch draws a fixed number of candidates
+    /// `M_e = ⌈n_e / q⌉`, where `q` is the acceptance rate (traced per candidate) of the
+    /// batch's earlier epochs (1 for the first), from its own independently scrambled
+    /// sequence, traces every accepted one and divides by `M_e`. `M_e` depends only on the
+    /// past, so each epoch is exactly unbiased given the past with any placement; the number
+    /// of traced rays is `n` on average rather than exactly. Needs frozen maps within an
+    /// epoch ([`Learning::Epochs`] or [`Learning::Off`]); without a map or with
+    /// [`Learning::Off`] the batch is split into 4 doubling epochs just to adapt `M_e`.
+    CandidateBudget,
     /// Stop at the `n`-th accepted candidate. Biased toward high-affinity directions (the
     /// talk's "families until n boys"); offered only to measure that bias.
     AtN,
@@ -193,6 +205,9 @@ pub enum BatchConfigError {
     ZeroCandidateCap,
     /// The epoch count is 0 or above [`crate::epochs::MAX_EPOCHS`].
     BadEpochCount(u32),
+    /// [`Stopping::CandidateBudget`] with [`Learning::Continuous`]: the map would change
+    /// inside an epoch of fixed size.
+    BudgetNeedsFrozenMap,
 }
 
 impl std::fmt::Display for BatchConfigError {
@@ -200,6 +215,10 @@ impl std::fmt::Display for BatchConfigError {
         match self {
             BatchConfigError::Map(e) => e.fmt(f),
             BatchConfigError::ZeroCandidateCap => write!(f, "candidate cap must be at least 1"),
+            BatchConfigError::BudgetNeedsFrozenMap => write!(
+                f,
+                "the candidate-budget stopping rule needs epochs or a fixed map, not continuous learning"
+            ),
             BatchConfigError::BadEpochCount(n) => write!(
                 f,
                 "epoch count {n} is invalid: it must be 1..={}",
@@ -222,7 +241,13 @@ pub struct Batch<V: Value> {
     deferred: Vec<DeferredUpdate>,
     plan: EpochPlan,
     n: u32,
+    seed: u64,
     epoch: usize,
+    /// Candidates the current epoch may draw (the budget, or the cap).
+    epoch_limit: u32,
+    previous_epoch_traced: u32,
+    previous_epoch_candidates: u32,
+    epoch_traced: u32,
     epoch_candidates: u32,
     epoch_accepted: u32,
     epoch_sum: V,
@@ -242,6 +267,12 @@ impl<V: Value> Batch<V> {
         if config.candidate_cap == 0 {
             return Err(BatchConfigError::ZeroCandidateCap);
         }
+        if config.stopping == Stopping::CandidateBudget
+            && config.affinity.is_some()
+            && config.learning == Learning::Continuous
+        {
+            return Err(BatchConfigError::BudgetNeedsFrozenMap);
+        }
         if let Learning::Epochs { epochs } = config.learning {
             if epochs == 0 || epochs as usize > crate::epochs::MAX_EPOCHS {
                 return Err(BatchConfigError::BadEpochCount(epochs));
@@ -260,7 +291,12 @@ impl<V: Value> Batch<V> {
             deferred: Vec::new(),
             plan: EpochPlan::single(1),
             n: 0,
+            seed: 0,
             epoch: 0,
+            epoch_limit: 0,
+            previous_epoch_traced: 0,
+            previous_epoch_candidates: 0,
+            epoch_traced: 0,
             epoch_candidates: 0,
             epoch_accepted: 0,
             epoch_sum: V::zero(),
@@ -310,12 +346,11 @@ impl<V: Value> Batch<V> {
                 map.clear();
             }
         }
-        match self.config.placement {
-            Placement::Halton => self.halton.rescramble(seed),
-            Placement::Random => self.rng = Pcg32::new(seed, 0x5241_4e44), // stream "RAND"
-        }
-        self.plan = match self.config.learning {
-            Learning::Epochs { epochs } if self.map.is_some() => EpochPlan::doubling(n, epochs),
+        self.plan = match (self.config.learning, self.config.stopping) {
+            (Learning::Epochs { epochs }, _) if self.map.is_some() => {
+                EpochPlan::doubling(n, epochs)
+            }
+            (_, Stopping::CandidateBudget) => EpochPlan::doubling(n, 4),
             _ => EpochPlan::single(n),
         };
         if self.deferred.capacity() < n as usize {
@@ -323,17 +358,46 @@ impl<V: Value> Batch<V> {
         }
         self.deferred.clear();
         self.n = n;
+        self.seed = seed;
         self.epoch = 0;
-        self.epoch_candidates = 0;
-        self.epoch_accepted = 0;
-        self.epoch_sum = V::zero();
+        self.previous_epoch_traced = 0;
+        self.previous_epoch_candidates = 0;
         self.total = V::zero();
-        self.next_index = 0;
         self.pending = None;
         self.done = false;
         self.batch_stats = Stats {
             batches: 1,
             ..Stats::default()
+        };
+        self.start_epoch();
+    }
+
+    /// Resets the epoch's counters, gives it an independently scrambled sequence, and sets
+    /// how many candidates it may draw.
+    fn start_epoch(&mut self) {
+        self.epoch_candidates = 0;
+        self.epoch_traced = 0;
+        self.epoch_accepted = 0;
+        self.epoch_sum = V::zero();
+        self.next_index = 0;
+        let epoch_seed =
+            crate::rng::mix64(self.seed ^ (self.epoch as u64).wrapping_mul(0x9E37_79B9));
+        match self.config.placement {
+            Placement::Halton => self.halton.rescramble(epoch_seed),
+            Placement::Random => self.rng = Pcg32::new(epoch_seed, 0x5241_4e44), // stream "RAND"
+        }
+        let size = self.plan.sizes()[self.epoch];
+        let cap = self.config.candidate_cap.saturating_mul(size);
+        self.epoch_limit = match self.config.stopping {
+            Stopping::CandidateBudget => {
+                // The previous epoch's acceptance rate (with one accepted pseudo-candidate so that
+                // a tiny epoch cannot give 0): it depends only on the past, so the budget is
+                // fixed given the past, and it reflects the most recent map.
+                let rate = (self.previous_epoch_traced + 1) as f64
+                    / (self.previous_epoch_candidates + 1) as f64;
+                ((size as f64 / rate).ceil() as u32).clamp(size, cap)
+            }
+            Stopping::DropLast | Stopping::AtN => cap,
         };
     }
 
@@ -346,8 +410,10 @@ impl<V: Value> Batch<V> {
             self.pending.is_none(),
             "Batch::record must follow a Decision::Trace before the next candidate"
         );
-        if !self.done && self.epoch_candidates >= self.epoch_cap() {
-            self.batch_stats.cap_hits += 1;
+        if !self.done && self.epoch_candidates >= self.epoch_limit {
+            if self.config.stopping != Stopping::CandidateBudget {
+                self.batch_stats.cap_hits += 1;
+            }
             self.close_epoch();
         }
         if self.done {
@@ -365,12 +431,6 @@ impl<V: Value> Batch<V> {
         };
         self.acceptance = u3;
         Some(Candidate { index, u: [u1, u2] })
-    }
-
-    fn epoch_cap(&self) -> u32 {
-        self.config
-            .candidate_cap
-            .saturating_mul(self.plan.sizes()[self.epoch])
     }
 
     /// Decides whether the current candidate, in `direction` (unit, in the map's frame), is
@@ -419,6 +479,7 @@ impl<V: Value> Batch<V> {
             .take()
             .expect("Batch::record called without a Decision::Trace");
         self.batch_stats.traced += 1;
+        self.epoch_traced += 1;
         self.epoch_sum = self
             .epoch_sum
             .add(contribution.scale(1.0 / pending.affinity as f64));
@@ -457,12 +518,13 @@ impl<V: Value> Batch<V> {
                 self.batch_stats.resets += outcome.resets as u64;
             }
         }
+        self.previous_epoch_traced = self.epoch_traced;
+        self.previous_epoch_candidates = self.epoch_candidates;
         self.epoch += 1;
-        self.epoch_candidates = 0;
-        self.epoch_accepted = 0;
-        self.epoch_sum = V::zero();
         if self.epoch == self.plan.sizes().len() {
             self.done = true;
+        } else {
+            self.start_epoch();
         }
     }
 
