@@ -2,10 +2,12 @@
 //!
 //! For every analytic scene, map rule and batch size it runs many independent batches and
 //! reports, against the exact integral:
-//! - the bias in standard errors, z = (mean − exact) / SE;
-//! - the variance gain at equal traced rays, Var(AIS off) / Var(configuration).
+//! - the variance gain at equal traced rays, (Var · traced) of the baseline over that of the
+//!   configuration (traced rays matter because the candidate-budget rule traces `n` only on
+//!   average);
+//! - the bias in standard errors, z = (mean − exact) / SE (bold when |z| ≥ 4).
 //!
-//! Run: `cargo run --release -p ais --example study -- [--batches N] [--section NAME]`.
+//! Run: `cargo run --release -p ais --example study -- [--batches N] [--section NAME]...`.
 //! Sections: `rules` (the full grid), `heights`, `placement`, `stopping`, `proposals`.
 
 use ais::analytic::{gather, GatherTarget, Proposal, Scene};
@@ -14,7 +16,7 @@ use ais::{
 };
 use std::sync::atomic::{AtomicUsize, Ordering};
 
-/// Mean, variance and mean traced rays and candidates of many batches.
+/// Mean, variance and mean traced rays of many batches.
 #[derive(Clone, Copy, Debug, Default)]
 struct Cell {
     mean: f64,
@@ -24,15 +26,33 @@ struct Cell {
     candidates: f64,
 }
 
-fn measure(
+/// One configuration of the study: a batch configuration and what the gather may skip.
+#[derive(Clone, Debug)]
+struct Setup {
+    label: String,
     config: BatchConfig,
-    scene: &Scene,
-    proposal: Proposal,
-    n: u32,
-    batches: u32,
     target: GatherTarget,
-) -> Cell {
-    let mut batch: Batch<f64> = Batch::new(config).expect("valid study configuration");
+}
+
+impl Setup {
+    fn new(label: &str, config: BatchConfig) -> Self {
+        Setup {
+            label: label.to_string(),
+            config,
+            target: GatherTarget::Normal,
+        }
+    }
+
+    fn oracle(label: &str, config: BatchConfig) -> Self {
+        Setup {
+            target: GatherTarget::Oracle,
+            ..Setup::new(label, config)
+        }
+    }
+}
+
+fn measure(setup: &Setup, scene: &Scene, proposal: Proposal, n: u32, batches: u32) -> Cell {
+    let mut batch: Batch<f64> = Batch::new(setup.config).expect("valid study configuration");
     let (mut sum, mut sum_sq) = (0.0, 0.0);
     for seed in 0..batches {
         let value = gather(
@@ -42,7 +62,7 @@ fn measure(
             n,
             seed as u64,
             MapStart::Empty,
-            target,
+            setup.target,
         )
         .value;
         sum += value;
@@ -61,7 +81,7 @@ fn measure(
     }
 }
 
-/// Runs `jobs` on two threads (the machine has two cores), keeping their order.
+/// Runs `jobs` jobs on all cores, keeping their order.
 fn run_parallel<T: Send, F: Fn(usize) -> T + Sync>(jobs: usize, work: F) -> Vec<T> {
     let next = AtomicUsize::new(0);
     let threads = std::thread::available_parallelism().map_or(2, |n| n.get());
@@ -89,39 +109,66 @@ fn run_parallel<T: Send, F: Fn(usize) -> T + Sync>(jobs: usize, work: F) -> Vec<
     results.into_iter().map(|(_, r)| r).collect()
 }
 
-/// Row-major index arithmetic over a K-dimensional grid of study cells.
-#[derive(Clone, Copy)]
-struct Grid<const K: usize>([usize; K]);
-
-impl<const K: usize> Grid<K> {
-    fn len(&self) -> usize {
-        self.0.iter().product()
-    }
-    fn split(&self, mut job: usize) -> [usize; K] {
-        let mut index = [0; K];
-        for k in (0..K).rev() {
-            index[k] = job % self.0[k];
-            job /= self.0[k];
+/// Measures every (scene, proposal, setup, n) and prints one table per scene and proposal,
+/// each cell relative to the setup at `baseline`.
+fn study(
+    title: &str,
+    scenes: &[Scene],
+    proposals: &[Proposal],
+    setups: &[Setup],
+    ns: &[u32],
+    batches: u32,
+    baseline: usize,
+    show_candidates: bool,
+) {
+    let per_scene = proposals.len() * setups.len() * ns.len();
+    let cells = run_parallel(scenes.len() * per_scene, |job| {
+        let (s, rest) = (job / per_scene, job % per_scene);
+        let (p, rest) = (
+            rest / (setups.len() * ns.len()),
+            rest % (setups.len() * ns.len()),
+        );
+        let (c, n) = (rest / ns.len(), rest % ns.len());
+        measure(&setups[c], &scenes[s], proposals[p], ns[n], batches)
+    });
+    let at = |s: usize, p: usize, c: usize, n: usize| {
+        cells[((s * proposals.len() + p) * setups.len() + c) * ns.len() + n]
+    };
+    for (s, scene) in scenes.iter().enumerate() {
+        for (p, proposal) in proposals.iter().enumerate() {
+            println!(
+                "\n#### {title}: scene `{}` ({:.0}% of the cosine-weighted hemisphere visible), {} proposal, {batches} batches per cell\n",
+                scene.name(),
+                scene.visible_cosine_fraction() * 100.0,
+                proposal.name()
+            );
+            let mut header = String::from("| configuration |");
+            let mut rule = String::from("|---|");
+            for n in ns {
+                header += &format!(" n = {n} |");
+                rule += "---|";
+                if show_candidates {
+                    header += &format!(" candidates / traced, n = {n} |");
+                    rule += "---|";
+                }
+            }
+            println!("{header}\n{rule}");
+            for (c, setup) in setups.iter().enumerate() {
+                let mut line = format!("| {} |", setup.label);
+                for n in 0..ns.len() {
+                    let cell = at(s, p, c, n);
+                    let base = at(s, p, baseline, n);
+                    let z = (cell.mean - scene.exact()) / cell.standard_error;
+                    let gain = (base.variance * base.traced) / (cell.variance * cell.traced);
+                    let bold = if z.abs() >= 4.0 { "**" } else { "" };
+                    line += &format!(" {gain:.2}× ({bold}z {z:+.1}{bold}) |");
+                    if show_candidates {
+                        line += &format!(" {:.2} |", cell.candidates / cell.traced);
+                    }
+                }
+                println!("{line}");
+            }
         }
-        index
-    }
-    fn join(&self, index: [usize; K]) -> usize {
-        index.iter().zip(self.0).fold(0, |acc, (&i, d)| acc * d + i)
-    }
-}
-
-#[derive(Clone, Copy)]
-struct Row {
-    label: &'static str,
-    config: BatchConfig,
-    target: GatherTarget,
-}
-
-fn level_label(levels: LevelRule) -> &'static str {
-    match levels {
-        LevelRule::Single => "single",
-        LevelRule::FinestBelowOne { .. } => "literal×3",
-        LevelRule::FinestWithSamples { .. } => "samples≥4×3",
     }
 }
 
@@ -134,34 +181,7 @@ fn map_config(height: u32, tol: f32, mode: Mode, levels: LevelRule) -> MapConfig
     }
 }
 
-fn tol_label(tol: f32) -> String {
-    if tol.is_infinite() {
-        "∞".into()
-    } else {
-        format!("{tol}")
-    }
-}
-
-fn print_table(title: &str, rows: &[(String, Vec<String>)], columns: &[String]) {
-    println!("\n{title}\n");
-    println!("| configuration | {} |", columns.join(" | "));
-    println!(
-        "|---|{}|",
-        columns.iter().map(|_| "---").collect::<Vec<_>>().join("|")
-    );
-    for (label, cells) in rows {
-        println!("| {label} | {} |", cells.join(" | "));
-    }
-}
-
-fn format_cell(cell: &Cell, baseline: &Cell, exact: f64) -> String {
-    let z = (cell.mean - exact) / cell.standard_error;
-    let gain = baseline.variance / cell.variance;
-    let flag = if z.abs() >= 4.0 { "**" } else { "" };
-    format!("{gain:.2}× ({flag}z {z:+.1}{flag})")
-}
-
-fn scenes() -> Vec<Scene> {
+fn all_scenes() -> Vec<Scene> {
     vec![
         Scene::open(),
         Scene::courtyard(),
@@ -170,23 +190,72 @@ fn scenes() -> Vec<Scene> {
     ]
 }
 
-/// The full grid: mode × level rule × tol × learning, per scene and n.
+fn random_off() -> BatchConfig {
+    BatchConfig {
+        placement: Placement::Random,
+        ..BatchConfig::off()
+    }
+}
+
+fn budget_off() -> BatchConfig {
+    BatchConfig {
+        stopping: Stopping::CandidateBudget,
+        ..BatchConfig::off()
+    }
+}
+
+/// The reference rows every table starts with.
+fn reference_setups() -> Vec<Setup> {
+    vec![
+        Setup::new("off, random", random_off()),
+        Setup::new("off, Halton", BatchConfig::off()),
+        Setup::oracle("oracle, random, n+1", random_off()),
+        Setup::oracle("oracle, Halton, budget", budget_off()),
+    ]
+}
+
+/// The three schedules: the talk's, and our two exactly unbiased ones.
+const SCHEDULES: [(&str, Learning, Placement, Stopping); 3] = [
+    (
+        "talk: continuous, Halton, n+1",
+        Learning::Continuous,
+        Placement::Halton,
+        Stopping::DropLast,
+    ),
+    (
+        "epochs, random, n+1",
+        Learning::Epochs { epochs: 4 },
+        Placement::Random,
+        Stopping::DropLast,
+    ),
+    (
+        "epochs, Halton, budget",
+        Learning::Epochs { epochs: 4 },
+        Placement::Halton,
+        Stopping::CandidateBudget,
+    ),
+];
+
+fn level_label(levels: LevelRule) -> &'static str {
+    match levels {
+        LevelRule::Single => "single",
+        LevelRule::FinestBelowOne { .. } => "literal×3",
+        LevelRule::FinestWithSamples { .. } => "samples≥4×3",
+    }
+}
+
+fn tol_label(tol: f32) -> String {
+    if tol.is_infinite() {
+        "∞".into()
+    } else {
+        format!("{tol}")
+    }
+}
+
+/// The full grid: schedule × mode × level rule × tol, per scene and n.
 fn rules_section(batches: u32) {
-    let ns = [8u32, 32, 128, 256];
-    let mut rows = vec![
-        Row {
-            label: "off",
-            config: BatchConfig::off(),
-            target: GatherTarget::Normal,
-        },
-        Row {
-            label: "oracle",
-            config: BatchConfig::off(),
-            target: GatherTarget::Oracle,
-        },
-    ];
-    let mut labels = vec!["off".to_string(), "oracle".to_string()];
-    for learning in [Learning::Continuous, Learning::Epochs { epochs: 4 }] {
+    let mut setups = reference_setups();
+    for (schedule, learning, placement, stopping) in SCHEDULES {
         for mode in [Mode::Aggressive, Mode::Conservative] {
             for levels in [
                 LevelRule::Single,
@@ -197,22 +266,8 @@ fn rules_section(batches: u32) {
                 },
             ] {
                 for tol in [f32::INFINITY, 1.0, 0.25] {
-                    rows.push(Row {
-                        label: "",
-                        config: BatchConfig {
-                            affinity: Some(map_config(8, tol, mode, levels)),
-                            learning,
-                            ..BatchConfig::default()
-                        },
-                        target: GatherTarget::Normal,
-                    });
-                    labels.push(format!(
-                        "{} {} {} tol {}",
-                        if learning == Learning::Continuous {
-                            "continuous"
-                        } else {
-                            "epochs"
-                        },
+                    let label = format!(
+                        "{schedule} · {} {} tol {}",
                         if mode == Mode::Aggressive {
                             "aggressive"
                         } else {
@@ -220,296 +275,217 @@ fn rules_section(batches: u32) {
                         },
                         level_label(levels),
                         tol_label(tol)
-                    ));
+                    );
+                    let config = BatchConfig {
+                        affinity: Some(map_config(8, tol, mode, levels)),
+                        learning,
+                        placement,
+                        stopping,
+                        ..BatchConfig::default()
+                    };
+                    setups.push(Setup::new(&label, config));
                 }
             }
         }
     }
-    let scenes = scenes();
-    let grid = Grid([scenes.len(), ns.len(), rows.len()]);
-    let cells = run_parallel(grid.len(), |job| {
-        let [s, n, r] = grid.split(job);
-        measure(
-            rows[r].config,
-            &scenes[s],
-            Proposal::CosineHemisphere,
-            ns[n],
-            batches,
-            rows[r].target,
-        )
-    });
-    let cell = |s: usize, n: usize, r: usize| cells[grid.join([s, n, r])];
-    let columns: Vec<String> = ns.iter().map(|n| format!("n = {n}")).collect();
-    for (s, scene) in scenes.iter().enumerate() {
-        let table: Vec<(String, Vec<String>)> = (0..rows.len())
-            .map(|r| {
-                let cells = (0..ns.len())
-                    .map(|n| format_cell(&cell(s, n, r), &cell(s, n, 0), scene.exact()))
-                    .collect();
-                (labels[r].clone(), cells)
-            })
-            .collect();
-        print_table(
-            &format!(
-                "#### Scene `{}` ({:.0}% of the cosine proposal visible), cosine proposal, height 8, {batches} batches per cell: variance gain vs off (z of bias)",
-                scene.name(),
-                scene.visible_cosine_fraction() * 100.0
-            ),
-            &table,
-            &columns,
-        );
-    }
+    study(
+        "Rules (height 8); variance gain at equal traced rays vs off with random placement (z of bias)",
+        &all_scenes(),
+        &[Proposal::CosineHemisphere],
+        &setups,
+        &[8, 32, 128, 256],
+        batches,
+        0,
+        false,
+    );
 }
 
-/// Map height sweep for the single-level rule with epochs and continuous learning.
+/// Map height sweep for the default schedule.
 fn heights_section(batches: u32) {
-    let heights = [2u32, 4, 8, 16, 32];
-    let ns = [32u32, 256];
-    let scenes = scenes();
-    let configs: Vec<(String, Learning, Mode, f32)> = vec![
-        (
-            "epochs conservative tol 1".into(),
-            Learning::Epochs { epochs: 4 },
-            Mode::Conservative,
-            1.0,
-        ),
-        (
-            "epochs aggressive tol 1".into(),
-            Learning::Epochs { epochs: 4 },
-            Mode::Aggressive,
-            1.0,
-        ),
-        (
-            "continuous conservative tol 1".into(),
-            Learning::Continuous,
-            Mode::Conservative,
-            1.0,
-        ),
-    ];
-    let grid = Grid([scenes.len(), configs.len(), heights.len(), ns.len()]);
-    let cells = run_parallel(grid.len(), |job| {
-        let [s, c, h, n] = grid.split(job);
-        let (_, learning, mode, tol) = configs[c].clone();
-        let config = BatchConfig {
-            affinity: Some(map_config(heights[h], tol, mode, LevelRule::Single)),
-            learning,
-            ..BatchConfig::default()
-        };
-        measure(
-            config,
-            &scenes[s],
-            Proposal::CosineHemisphere,
-            ns[n],
-            batches,
-            GatherTarget::Normal,
-        )
-    });
-    let baselines = run_parallel(scenes.len() * ns.len(), |job| {
-        measure(
-            BatchConfig::off(),
-            &scenes[job / ns.len()],
-            Proposal::CosineHemisphere,
-            ns[job % ns.len()],
-            batches,
-            GatherTarget::Normal,
-        )
-    });
-    let columns: Vec<String> = heights
-        .iter()
-        .flat_map(|h| ns.iter().map(move |n| format!("h {h}, n {n}")))
-        .collect();
-    let mut table = Vec::new();
-    for (s, scene) in scenes.iter().enumerate() {
-        for (c, config) in configs.iter().enumerate() {
-            let mut row = Vec::new();
-            for h in 0..heights.len() {
-                for n in 0..ns.len() {
-                    row.push(format_cell(
-                        &cells[grid.join([s, c, h, n])],
-                        &baselines[s * ns.len() + n],
-                        scene.exact(),
-                    ));
+    let mut setups = vec![Setup::new("off, Halton", BatchConfig::off())];
+    for mode in [Mode::Conservative, Mode::Aggressive] {
+        for height in [2u32, 4, 8, 16, 32] {
+            let label = format!(
+                "{} h {height}",
+                if mode == Mode::Aggressive {
+                    "aggressive"
+                } else {
+                    "conservative"
                 }
-            }
-            table.push((format!("{} · {}", scene.name(), config.0), row));
-        }
-    }
-    print_table(
-        &format!("#### Map height (single level), cosine proposal, {batches} batches per cell: variance gain vs off (z of bias)"),
-        &table,
-        &columns,
-    );
-}
-
-/// Halton versus simple random placement, with AIS off and with the default configuration.
-fn placement_section(batches: u32) {
-    let ns = [8u32, 32, 128];
-    let scenes = scenes();
-    let configs = [
-        (
-            "off, random",
-            BatchConfig {
-                placement: Placement::Random,
-                ..BatchConfig::off()
-            },
-        ),
-        ("off, Halton", BatchConfig::off()),
-        (
-            "default AIS, random",
-            BatchConfig {
-                placement: Placement::Random,
+            );
+            let config = BatchConfig {
+                affinity: Some(map_config(height, 1.0, mode, LevelRule::Single)),
                 ..BatchConfig::default()
+            };
+            setups.push(Setup::new(&label, config));
+        }
+    }
+    study(
+        "Map height (epochs, Halton, budget, single level, tol 1); variance gain at equal traced rays vs off with Halton placement (z of bias)",
+        &all_scenes(),
+        &[Proposal::CosineHemisphere],
+        &setups,
+        &[32, 256],
+        batches,
+        0,
+        false,
+    );
+}
+
+/// Halton versus simple random placement (the talk's figure), with AIS off and on.
+fn placement_section(batches: u32) {
+    let default = BatchConfig::default();
+    let setups = vec![
+        Setup::new("off, random", random_off()),
+        Setup::new("off, Halton", BatchConfig::off()),
+        Setup::new(
+            "default AIS, random, n+1",
+            BatchConfig {
+                placement: Placement::Random,
+                stopping: Stopping::DropLast,
+                ..default
             },
         ),
-        ("default AIS, Halton", BatchConfig::default()),
+        Setup::new(
+            "default AIS, Halton, n+1",
+            BatchConfig {
+                stopping: Stopping::DropLast,
+                ..default
+            },
+        ),
+        Setup::new(
+            "default AIS, Halton, budget",
+            BatchConfig {
+                stopping: Stopping::CandidateBudget,
+                ..default
+            },
+        ),
     ];
-    let grid = Grid([scenes.len(), configs.len(), ns.len()]);
-    let cells = run_parallel(grid.len(), |job| {
-        let [s, c, n] = grid.split(job);
-        measure(
-            configs[c].1,
-            &scenes[s],
-            Proposal::CosineHemisphere,
-            ns[n],
-            batches,
-            GatherTarget::Normal,
-        )
-    });
-    let columns: Vec<String> = ns.iter().map(|n| format!("n = {n}")).collect();
-    let mut table = Vec::new();
-    for (s, scene) in scenes.iter().enumerate() {
-        // Baseline: AIS off with random placement.
-        for (c, config) in configs.iter().enumerate() {
-            let row = (0..ns.len())
-                .map(|n| {
-                    let at = |c: usize| cells[grid.join([s, c, n])];
-                    format_cell(&at(c), &at(0), scene.exact())
-                })
-                .collect();
-            table.push((format!("{} · {}", scene.name(), config.0), row));
-        }
-    }
-    print_table(
-        &format!("#### Placement, cosine proposal, {batches} batches per cell: variance gain vs AIS off with random placement (z of bias)"),
-        &table,
-        &columns,
+    study(
+        "Placement; variance gain at equal traced rays vs off with random placement (z of bias)",
+        &all_scenes(),
+        &[Proposal::CosineHemisphere],
+        &setups,
+        &[8, 32, 128],
+        batches,
+        0,
+        false,
     );
 }
 
-/// The n+1 rule against stopping at the n-th acceptance.
+/// The n+1 rule against stopping at the n-th acceptance, and placement's effect on bias.
 fn stopping_section(batches: u32) {
-    let ns = [1u32, 4, 8, 32];
-    let scenes = scenes();
-    let configs = [
+    let map = Some(map_config(
+        8,
+        f32::INFINITY,
+        Mode::Aggressive,
+        LevelRule::Single,
+    ));
+    let epochs = Learning::Epochs { epochs: 4 };
+    let rows = [
         (
-            "continuous, drop last (n+1)",
-            Learning::Continuous,
+            "oracle, random, n+1",
+            None,
+            Learning::Off,
             Stopping::DropLast,
-        ),
-        ("continuous, stop at n", Learning::Continuous, Stopping::AtN),
-        (
-            "epochs, drop last (n+1)",
-            Learning::Epochs { epochs: 4 },
-            Stopping::DropLast,
+            Placement::Random,
         ),
         (
-            "epochs, stop at n",
-            Learning::Epochs { epochs: 4 },
+            "oracle, random, stop at n",
+            None,
+            Learning::Off,
             Stopping::AtN,
+            Placement::Random,
+        ),
+        (
+            "oracle, Halton, n+1",
+            None,
+            Learning::Off,
+            Stopping::DropLast,
+            Placement::Halton,
+        ),
+        (
+            "oracle, Halton, budget",
+            None,
+            Learning::Off,
+            Stopping::CandidateBudget,
+            Placement::Halton,
+        ),
+        (
+            "epochs, random, n+1",
+            map,
+            epochs,
+            Stopping::DropLast,
+            Placement::Random,
+        ),
+        (
+            "epochs, random, stop at n",
+            map,
+            epochs,
+            Stopping::AtN,
+            Placement::Random,
+        ),
+        (
+            "epochs, Halton, n+1",
+            map,
+            epochs,
+            Stopping::DropLast,
+            Placement::Halton,
+        ),
+        (
+            "epochs, Halton, budget",
+            map,
+            epochs,
+            Stopping::CandidateBudget,
+            Placement::Halton,
         ),
     ];
-    let grid = Grid([scenes.len(), configs.len(), ns.len()]);
-    let cells = run_parallel(grid.len(), |job| {
-        let [s, c, n] = grid.split(job);
-        let config = BatchConfig {
-            affinity: Some(map_config(
-                8,
-                f32::INFINITY,
-                Mode::Aggressive,
-                LevelRule::Single,
-            )),
-            learning: configs[c].1,
-            stopping: configs[c].2,
-            ..BatchConfig::default()
-        };
-        measure(
-            config,
-            &scenes[s],
-            Proposal::CosineHemisphere,
-            ns[n],
-            batches,
-            GatherTarget::Normal,
-        )
-    });
-    let columns: Vec<String> = ns.iter().map(|n| format!("n = {n}")).collect();
-    let mut table = Vec::new();
-    for (s, scene) in scenes.iter().enumerate() {
-        for (c, config) in configs.iter().enumerate() {
-            let row = (0..ns.len())
-                .map(|n| {
-                    let cell = cells[grid.join([s, c, n])];
-                    let z = (cell.mean - scene.exact()) / cell.standard_error;
-                    let relative = (cell.mean - scene.exact()) / scene.exact() * 100.0;
-                    format!("{relative:+.2}% (z {z:+.1})")
-                })
-                .collect();
-            table.push((format!("{} · {}", scene.name(), config.0), row));
-        }
-    }
-    print_table(
-        &format!("#### Stopping rule, aggressive single level h 8 tol ∞, {batches} batches per cell: relative bias (z)"),
-        &table,
-        &columns,
+    let setups: Vec<Setup> = rows
+        .iter()
+        .map(|&(label, affinity, learning, stopping, placement)| {
+            let config = BatchConfig {
+                affinity,
+                learning,
+                stopping,
+                placement,
+                ..BatchConfig::default()
+            };
+            if affinity.is_none() {
+                Setup::oracle(label, config)
+            } else {
+                Setup::new(label, config)
+            }
+        })
+        .collect();
+    study(
+        "Stopping rule and placement (maps: aggressive, single level, h 8, tol ∞); variance gain vs the first row (z of bias)",
+        &[Scene::window(0.35), Scene::window(0.10)],
+        &[Proposal::CosineHemisphere],
+        &setups,
+        &[1, 8, 32],
+        batches,
+        0,
+        false,
     );
 }
 
-/// The uniform-sphere proposal (half its candidates are unconditional rejections).
+/// The uniform-sphere proposal (half of its candidates are unconditional rejections).
 fn proposals_section(batches: u32) {
-    let ns = [32u32, 256];
-    let scenes = scenes();
-    let configs = [
-        ("off", BatchConfig::off(), GatherTarget::Normal),
-        ("oracle", BatchConfig::off(), GatherTarget::Oracle),
-        ("default AIS", BatchConfig::default(), GatherTarget::Normal),
+    let setups = vec![
+        Setup::new("off, Halton, n+1", BatchConfig::off()),
+        Setup::new("off, Halton, budget", budget_off()),
+        Setup::oracle("oracle, Halton, budget", budget_off()),
+        Setup::new("default AIS", BatchConfig::default()),
     ];
-    let proposals = [Proposal::UniformSphere, Proposal::CosineHemisphere];
-    let grid = Grid([scenes.len(), proposals.len(), configs.len(), ns.len()]);
-    let cells = run_parallel(grid.len(), |job| {
-        let [s, p, c, n] = grid.split(job);
-        measure(
-            configs[c].1,
-            &scenes[s],
-            proposals[p],
-            ns[n],
-            batches,
-            configs[c].2,
-        )
-    });
-    let columns: Vec<String> = ns
-        .iter()
-        .flat_map(|n| [format!("n = {n}"), format!("candidates/traced, n = {n}")])
-        .collect();
-    let mut table = Vec::new();
-    for (s, scene) in scenes.iter().enumerate() {
-        for (p, proposal) in proposals.iter().enumerate() {
-            for (c, config) in configs.iter().enumerate() {
-                let mut row = Vec::new();
-                for n in 0..ns.len() {
-                    let at = |c: usize| cells[grid.join([s, p, c, n])];
-                    row.push(format_cell(&at(c), &at(0), scene.exact()));
-                    row.push(format!("{:.2}", at(c).candidates / at(c).traced));
-                }
-                table.push((
-                    format!("{} · {} · {}", scene.name(), proposal.name(), config.0),
-                    row,
-                ));
-            }
-        }
-    }
-    print_table(
-        &format!("#### Proposals, {batches} batches per cell: variance gain vs off with the same proposal (z of bias)"),
-        &table,
-        &columns,
+    study(
+        "Proposals; variance gain at equal traced rays vs the first row (z of bias)",
+        &all_scenes(),
+        &[Proposal::UniformSphere, Proposal::CosineHemisphere],
+        &setups,
+        &[32, 256],
+        batches,
+        0,
+        true,
     );
 }
 

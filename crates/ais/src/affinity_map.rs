@@ -84,7 +84,7 @@ impl Default for MapConfig {
     /// The defaults chosen from the study in BENCHMARKS.md.
     fn default() -> Self {
         MapConfig {
-            height: 8,
+            height: 4,
             tol: 1.0,
             mode: Mode::Conservative,
             levels: LevelRule::Single,

@@ -108,7 +108,7 @@ impl Default for BatchConfig {
             affinity: Some(MapConfig::default()),
             learning: Learning::Epochs { epochs: 4 },
             placement: Placement::Halton,
-            stopping: Stopping::DropLast,
+            stopping: Stopping::CandidateBudget,
             candidate_cap: 64,
         }
     }
@@ -116,10 +116,15 @@ impl Default for BatchConfig {
 
 impl BatchConfig {
     /// AIS off: a plain batch of `n` traced rays (the baseline every mode is compared with).
+    ///
+    /// It keeps the talk's n+1 rule: with no map and a proposal that stays inside the
+    /// support, every candidate is traced, so exactly `n` are and the rule is exact with any
+    /// placement.
     pub fn off() -> Self {
         BatchConfig {
             affinity: None,
             learning: Learning::Off,
+            stopping: Stopping::DropLast,
             ..BatchConfig::default()
         }
     }
