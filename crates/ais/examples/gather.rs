@@ -1,0 +1,122 @@
+//! Gathers direct light at a point of an analytic scene with AIS off and on, and prints the
+//! estimate, the exact value, and where the candidates went.
+//!
+//! Run: `cargo run --release -p ais --example gather -- [--scene open|courtyard|window35|window10] [--rays N] [--batches B]`
+
+use ais::analytic::{gather, GatherTarget, Proposal, Scene};
+use ais::{Batch, BatchConfig, MapStart, Mode};
+
+fn parse_args() -> Result<(Scene, u32, u32), String> {
+    let (mut scene, mut rays, mut batches) = (Scene::window(0.10), 256u32, 2_000u32);
+    let mut args = std::env::args().skip(1);
+    while let Some(flag) = args.next() {
+        let value = args.next().ok_or(format!("{flag} needs a value"))?;
+        match flag.as_str() {
+            "--scene" => {
+                scene = match value.as_str() {
+                    "open" => Scene::open(),
+                    "courtyard" => Scene::courtyard(),
+                    "window35" => Scene::window(0.35),
+                    "window10" => Scene::window(0.10),
+                    other => {
+                        return Err(format!(
+                            "unknown scene {other:?}: use open, courtyard, window35 or window10"
+                        ))
+                    }
+                }
+            }
+            "--rays" => {
+                rays = value
+                    .parse()
+                    .ok()
+                    .filter(|&n| n >= 1)
+                    .ok_or("--rays needs a positive integer")?
+            }
+            "--batches" => {
+                batches = value
+                    .parse()
+                    .ok()
+                    .filter(|&n| n >= 2)
+                    .ok_or("--batches needs an integer of at least 2")?
+            }
+            other => return Err(format!("unknown flag {other:?}")),
+        }
+    }
+    Ok((scene, rays, batches))
+}
+
+fn main() {
+    let (scene, rays, batches) = parse_args().unwrap_or_else(|message| {
+        eprintln!("error: {message}");
+        std::process::exit(2);
+    });
+    let exact = scene.exact();
+    println!(
+        "scene {}: {:.0}% of the cosine-weighted hemisphere visible, exact integral {exact:.6}",
+        scene.name(),
+        scene.visible_cosine_fraction() * 100.0
+    );
+    println!("{batches} batches of {rays} rays each, cosine proposal\n");
+    println!(
+        "{:<24} {:>10} {:>9} {:>8} {:>11} {:>9} {:>9} {:>9} {:>10}",
+        "mode",
+        "estimate",
+        "± 1 SE",
+        "z",
+        "rel. RMSE",
+        "traced",
+        "rejected",
+        "dropped",
+        "map bytes"
+    );
+    let modes = [
+        ("off", BatchConfig::off()),
+        (
+            "aggressive",
+            BatchConfig {
+                affinity: Some(ais::MapConfig {
+                    mode: Mode::Aggressive,
+                    ..ais::MapConfig::default()
+                }),
+                ..BatchConfig::default()
+            },
+        ),
+        ("conservative (default)", BatchConfig::default()),
+    ];
+    for (name, config) in modes {
+        let mut batch: Batch<f64> = Batch::new(config).expect("valid configuration");
+        let (mut sum, mut sum_sq, mut squared_error) = (0.0, 0.0, 0.0);
+        for seed in 0..batches {
+            let estimate = gather(
+                &mut batch,
+                &scene,
+                Proposal::CosineHemisphere,
+                rays,
+                seed as u64,
+                MapStart::Empty,
+                GatherTarget::Normal,
+            );
+            sum += estimate.value;
+            sum_sq += estimate.value * estimate.value;
+            squared_error += (estimate.value - exact).powi(2);
+        }
+        let count = batches as f64;
+        let mean = sum / count;
+        let standard_error = ((sum_sq / count - mean * mean) / (count - 1.0)).sqrt();
+        let stats = batch.stats();
+        println!(
+            "{:<24} {:>10.6} {:>9.6} {:>+8.2} {:>11.4} {:>9.1} {:>9.1} {:>9.1} {:>10}",
+            name,
+            mean,
+            standard_error,
+            (mean - exact) / standard_error,
+            (squared_error / count).sqrt() / exact,
+            stats.traced as f64 / count,
+            stats.rejected() as f64 / count,
+            stats.dropped as f64 / count,
+            batch.map().map_or(0, |m| m.memory_bytes()),
+        );
+    }
+    println!("\nper batch: traced = rays traced, rejected = skipped untraced (outside support or by roulette).");
+    println!("rel. RMSE is per batch; lower is better at similar traced counts.");
+}
