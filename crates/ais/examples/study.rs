@@ -109,18 +109,31 @@ fn run_parallel<T: Send, F: Fn(usize) -> T + Sync>(jobs: usize, work: F) -> Vec<
     results.into_iter().map(|(_, r)| r).collect()
 }
 
-/// Measures every (scene, proposal, setup, n) and prints one table per scene and proposal,
-/// each cell relative to the setup at `baseline`.
-fn study(
-    title: &str,
-    scenes: &[Scene],
-    proposals: &[Proposal],
-    setups: &[Setup],
-    ns: &[u32],
-    batches: u32,
+/// One table of the study: every (scene, proposal, setup, n) cell.
+struct Table<'a> {
+    title: &'a str,
+    scenes: &'a [Scene],
+    proposals: &'a [Proposal],
+    setups: &'a [Setup],
+    ns: &'a [u32],
+    /// The setup every cell is compared with.
     baseline: usize,
+    /// Whether to add a candidates-per-traced-ray column.
     show_candidates: bool,
-) {
+}
+
+/// Measures every cell of `table` and prints one table per scene and proposal, each cell
+/// relative to the baseline setup.
+fn study(table: Table, batches: u32) {
+    let Table {
+        title,
+        scenes,
+        proposals,
+        setups,
+        ns,
+        baseline,
+        show_candidates,
+    } = table;
     let per_scene = proposals.len() * setups.len() * ns.len();
     let cells = run_parallel(scenes.len() * per_scene, |job| {
         let (s, rest) = (job / per_scene, job % per_scene);
@@ -289,14 +302,16 @@ fn rules_section(batches: u32) {
         }
     }
     study(
-        "Rules (height 8); variance gain at equal traced rays vs off with random placement (z of bias)",
-        &all_scenes(),
-        &[Proposal::CosineHemisphere],
-        &setups,
-        &[8, 32, 128, 256],
+        Table {
+            title: "Rules (height 8); variance gain at equal traced rays vs off with random placement (z of bias)",
+            scenes: &all_scenes(),
+            proposals: &[Proposal::CosineHemisphere],
+            setups: &setups,
+            ns: &[8, 32, 128, 256],
+            baseline: 0,
+            show_candidates: false,
+        },
         batches,
-        0,
-        false,
     );
 }
 
@@ -321,14 +336,16 @@ fn heights_section(batches: u32) {
         }
     }
     study(
-        "Map height (epochs, Halton, budget, single level, tol 1); variance gain at equal traced rays vs off with Halton placement (z of bias)",
-        &all_scenes(),
-        &[Proposal::CosineHemisphere],
-        &setups,
-        &[32, 256],
+        Table {
+            title: "Map height (epochs, Halton, budget, single level, tol 1); variance gain at equal traced rays vs off with Halton placement (z of bias)",
+            scenes: &all_scenes(),
+            proposals: &[Proposal::CosineHemisphere],
+            setups: &setups,
+            ns: &[32, 256],
+            baseline: 0,
+            show_candidates: false,
+        },
         batches,
-        0,
-        false,
     );
 }
 
@@ -362,14 +379,16 @@ fn placement_section(batches: u32) {
         ),
     ];
     study(
-        "Placement; variance gain at equal traced rays vs off with random placement (z of bias)",
-        &all_scenes(),
-        &[Proposal::CosineHemisphere],
-        &setups,
-        &[8, 32, 128],
+        Table {
+            title: "Placement; variance gain at equal traced rays vs off with random placement (z of bias)",
+            scenes: &all_scenes(),
+            proposals: &[Proposal::CosineHemisphere],
+            setups: &setups,
+            ns: &[8, 32, 128],
+            baseline: 0,
+            show_candidates: false,
+        },
         batches,
-        0,
-        false,
     );
 }
 
@@ -458,14 +477,16 @@ fn stopping_section(batches: u32) {
         })
         .collect();
     study(
-        "Stopping rule and placement (maps: aggressive, single level, h 8, tol ∞); variance gain vs the first row (z of bias)",
-        &[Scene::window(0.35), Scene::window(0.10)],
-        &[Proposal::CosineHemisphere],
-        &setups,
-        &[1, 8, 32],
+        Table {
+            title: "Stopping rule and placement (maps: aggressive, single level, h 8, tol ∞); variance gain vs the first row (z of bias)",
+            scenes: &[Scene::window(0.35), Scene::window(0.10)],
+            proposals: &[Proposal::CosineHemisphere],
+            setups: &setups,
+            ns: &[1, 8, 32],
+            baseline: 0,
+            show_candidates: false,
+        },
         batches,
-        0,
-        false,
     );
 }
 
@@ -478,14 +499,16 @@ fn proposals_section(batches: u32) {
         Setup::new("default AIS", BatchConfig::default()),
     ];
     study(
-        "Proposals; variance gain at equal traced rays vs the first row (z of bias)",
-        &all_scenes(),
-        &[Proposal::UniformSphere, Proposal::CosineHemisphere],
-        &setups,
-        &[32, 256],
+        Table {
+            title: "Proposals; variance gain at equal traced rays vs the first row (z of bias)",
+            scenes: &all_scenes(),
+            proposals: &[Proposal::UniformSphere, Proposal::CosineHemisphere],
+            setups: &setups,
+            ns: &[32, 256],
+            baseline: 0,
+            show_candidates: true,
+        },
         batches,
-        0,
-        true,
     );
 }
 
