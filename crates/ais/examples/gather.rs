@@ -71,17 +71,17 @@ fn main() {
     );
     let modes = [
         ("off", BatchConfig::off()),
+        ("aggressive (default)", BatchConfig::default()),
         (
-            "aggressive",
+            "conservative",
             BatchConfig {
                 affinity: Some(ais::MapConfig {
-                    mode: Mode::Aggressive,
+                    mode: Mode::Conservative,
                     ..ais::MapConfig::default()
                 }),
                 ..BatchConfig::default()
             },
         ),
-        ("conservative (default)", BatchConfig::default()),
     ];
     for (name, config) in modes {
         let mut batch: Batch<f64> = Batch::new(config).expect("valid configuration");

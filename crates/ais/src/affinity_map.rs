@@ -86,7 +86,7 @@ impl Default for MapConfig {
         MapConfig {
             height: 4,
             tol: 1.0,
-            mode: Mode::Conservative,
+            mode: Mode::Aggressive,
             levels: LevelRule::Single,
         }
     }
