@@ -562,3 +562,158 @@ pub fn rating(actual: f32, unoccluded: f32) -> f32 {
         1.0
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::affinity_map::Mode;
+
+    /// Drives a batch whose host alternates in- and out-of-support candidates and sees every
+    /// traced ray occluded when `x < 0`.
+    fn drive(batch: &mut Batch<f32>, n: u32, seed: u64, start: MapStart) -> Estimate<f32> {
+        batch.begin(n, seed, start);
+        while let Some(candidate) = batch.next_candidate() {
+            let phi = std::f32::consts::TAU * candidate.u[1];
+            let direction = Vec3::new(phi.cos(), phi.sin(), 0.2).normalize();
+            let in_support = candidate.u[0] < 0.5;
+            if let Decision::Trace { .. } = batch.decide(direction, in_support) {
+                let visible = direction.x >= 0.0;
+                batch.record(
+                    if visible { 1.0 } else { 0.0 },
+                    rating(visible as u8 as f32, 1.0),
+                );
+            }
+        }
+        batch.finish()
+    }
+
+    #[test]
+    fn outside_support_candidates_count_but_are_never_traced() {
+        let mut batch: Batch<f32> = Batch::new(BatchConfig {
+            placement: Placement::Random,
+            ..BatchConfig::off()
+        })
+        .unwrap();
+        let estimate = drive(&mut batch, 64, 3, MapStart::Empty);
+        let stats = batch.stats();
+        assert_eq!(estimate.traced, 64);
+        assert_eq!(stats.dropped, 1);
+        assert_eq!(stats.rejected_roulette, 0);
+        assert_eq!(
+            stats.candidates,
+            stats.traced + stats.rejected_outside_support
+        );
+        assert!(stats.rejected_outside_support > 20);
+    }
+
+    #[test]
+    fn a_fixed_map_is_never_changed_and_a_warm_map_keeps_learning() {
+        let map = MapConfig {
+            height: 8,
+            mode: Mode::Aggressive,
+            ..MapConfig::default()
+        };
+        let mut fixed: Batch<f32> = Batch::new(BatchConfig {
+            affinity: Some(map),
+            learning: Learning::Off,
+            ..BatchConfig::default()
+        })
+        .unwrap();
+        let before = fixed.map().unwrap().clone();
+        drive(&mut fixed, 32, 1, MapStart::Current);
+        let after = fixed.map().unwrap();
+        let layout = after.level_layout(0);
+        for index in 0..layout.texel_count() {
+            let texel = layout.texel_of_index(index);
+            assert_eq!(
+                before.texel_samples(0, texel),
+                after.texel_samples(0, texel)
+            );
+        }
+
+        let mut warm: Batch<f32> = Batch::new(BatchConfig {
+            affinity: Some(map),
+            learning: Learning::Continuous,
+            stopping: Stopping::DropLast,
+            ..BatchConfig::default()
+        })
+        .unwrap();
+        let samples = |b: &Batch<f32>| {
+            let m = b.map().unwrap();
+            let layout = m.level_layout(0);
+            (0..layout.texel_count())
+                .map(|i| m.texel_samples(0, layout.texel_of_index(i)))
+                .sum::<u32>()
+        };
+        drive(&mut warm, 32, 1, MapStart::Empty);
+        let first = samples(&warm);
+        drive(&mut warm, 32, 2, MapStart::Current);
+        assert!(
+            samples(&warm) > first,
+            "a warm start keeps what was learned"
+        );
+        drive(&mut warm, 32, 3, MapStart::Empty);
+        assert!(samples(&warm) <= 32, "an empty start forgets");
+    }
+
+    #[test]
+    fn epochs_defer_updates_to_epoch_ends() {
+        let mut batch: Batch<f32> = Batch::new(BatchConfig {
+            affinity: Some(MapConfig::default()),
+            learning: Learning::Epochs { epochs: 4 },
+            stopping: Stopping::DropLast,
+            placement: Placement::Random,
+            ..BatchConfig::default()
+        })
+        .unwrap();
+        let estimate = drive(&mut batch, 64, 9, MapStart::Empty);
+        assert_eq!(estimate.traced, 64);
+        // One dropped candidate per epoch.
+        assert_eq!(batch.stats().dropped, 4);
+    }
+
+    #[test]
+    fn invalid_configurations_are_refused() {
+        let zero_cap = BatchConfig {
+            candidate_cap: 0,
+            ..BatchConfig::default()
+        };
+        assert_eq!(
+            Batch::<f32>::new(zero_cap).unwrap_err(),
+            BatchConfigError::ZeroCandidateCap
+        );
+        let budget_continuous = BatchConfig {
+            learning: Learning::Continuous,
+            ..BatchConfig::default()
+        };
+        assert_eq!(
+            Batch::<f32>::new(budget_continuous).unwrap_err(),
+            BatchConfigError::BudgetNeedsFrozenMap
+        );
+        let many_epochs = BatchConfig {
+            learning: Learning::Epochs { epochs: 99 },
+            ..BatchConfig::default()
+        };
+        assert_eq!(
+            Batch::<f32>::new(many_epochs).unwrap_err(),
+            BatchConfigError::BadEpochCount(99)
+        );
+    }
+
+    #[test]
+    #[should_panic(expected = "without a Decision::Trace")]
+    fn record_without_trace_panics() {
+        let mut batch: Batch<f32> = Batch::new(BatchConfig::default()).unwrap();
+        batch.begin(4, 0, MapStart::Empty);
+        batch.next_candidate();
+        batch.record(1.0, 1.0);
+    }
+
+    #[test]
+    fn rating_is_clamped_and_uninformative_rays_rate_one() {
+        assert_eq!(rating(0.5, 1.0), 0.5);
+        assert_eq!(rating(3.0, 1.0), 1.0);
+        assert_eq!(rating(0.0, 0.0), 1.0);
+        assert_eq!(rating(-1.0, 2.0), 0.0);
+    }
+}
