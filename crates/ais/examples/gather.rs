@@ -3,7 +3,7 @@
 //!
 //! Run: `cargo run --release -p ais --example gather -- [--scene open|courtyard|window35|window10] [--rays N] [--batches B]`
 
-use ais::analytic::{gather, GatherTarget, Proposal, Scene};
+use ais::analytic::{gather, GatherTarget, Moments, Proposal, Scene};
 use ais::{Batch, BatchConfig, MapStart, Mode};
 
 fn parse_args() -> Result<(Scene, u32, u32), String> {
@@ -85,7 +85,7 @@ fn main() {
     ];
     for (name, config) in modes {
         let mut batch: Batch<f64> = Batch::new(config).expect("valid configuration");
-        let (mut sum, mut sum_sq, mut squared_error) = (0.0, 0.0, 0.0);
+        let (mut moments, mut squared_error) = (Moments::default(), 0.0);
         for seed in 0..batches {
             let estimate = gather(
                 &mut batch,
@@ -96,13 +96,11 @@ fn main() {
                 MapStart::Empty,
                 GatherTarget::Normal,
             );
-            sum += estimate.value;
-            sum_sq += estimate.value * estimate.value;
+            moments.add(estimate.value);
             squared_error += (estimate.value - exact).powi(2);
         }
         let count = batches as f64;
-        let mean = sum / count;
-        let standard_error = ((sum_sq / count - mean * mean) / (count - 1.0)).sqrt();
+        let (mean, standard_error) = (moments.mean(), moments.standard_error());
         let stats = batch.stats();
         println!(
             "{:<24} {:>10.6} {:>9.6} {:>+8.2} {:>11.4} {:>9.1} {:>9.1} {:>9.1} {:>10}",

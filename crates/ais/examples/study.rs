@@ -10,7 +10,7 @@
 //! Run: `cargo run --release -p ais --example study -- [--batches N] [--section NAME]...`.
 //! Sections: `rules` (the full grid), `heights`, `placement`, `stopping`, `proposals`.
 
-use ais::analytic::{gather, GatherTarget, Proposal, Scene};
+use ais::analytic::{gather, GatherTarget, Moments, Proposal, Scene};
 use ais::{
     Batch, BatchConfig, Learning, LevelRule, MapConfig, MapStart, Mode, Placement, Stopping,
 };
@@ -53,9 +53,9 @@ impl Setup {
 
 fn measure(setup: &Setup, scene: &Scene, proposal: Proposal, n: u32, batches: u32) -> Cell {
     let mut batch: Batch<f64> = Batch::new(setup.config).expect("valid study configuration");
-    let (mut sum, mut sum_sq) = (0.0, 0.0);
+    let mut moments = Moments::default();
     for seed in 0..batches {
-        let value = gather(
+        let estimate = gather(
             &mut batch,
             scene,
             proposal,
@@ -63,19 +63,15 @@ fn measure(setup: &Setup, scene: &Scene, proposal: Proposal, n: u32, batches: u3
             seed as u64,
             MapStart::Empty,
             setup.target,
-        )
-        .value;
-        sum += value;
-        sum_sq += value * value;
+        );
+        moments.add(estimate.value);
     }
     let count = batches as f64;
-    let mean = sum / count;
-    let variance = (sum_sq / count - mean * mean) * count / (count - 1.0);
     let stats = batch.stats();
     Cell {
-        mean,
-        variance,
-        standard_error: (variance / count).sqrt(),
+        mean: moments.mean(),
+        variance: moments.variance(),
+        standard_error: moments.standard_error(),
         traced: stats.traced as f64 / count,
         candidates: stats.candidates as f64 / count,
     }

@@ -90,36 +90,25 @@ fn halton_placement_biases_the_n_plus_one_rule_but_not_the_candidate_budget() {
     // The oracle rejects occluded candidates for free: a fixed acceptance probability.
     let scene = Scene::window(0.10);
     for n in [1, 8] {
-        let halton_n_plus_one = summarize(
-            BatchConfig::off(),
-            &scene,
-            Proposal::CosineHemisphere,
-            n,
-            BATCHES,
-            GatherTarget::Oracle,
-        );
-        let halton_budget = summarize(
-            BatchConfig {
-                stopping: Stopping::CandidateBudget,
-                ..BatchConfig::off()
-            },
-            &scene,
-            Proposal::CosineHemisphere,
-            n,
-            BATCHES,
-            GatherTarget::Oracle,
-        );
-        let random_n_plus_one = summarize(
-            BatchConfig {
-                placement: Placement::Random,
-                ..BatchConfig::off()
-            },
-            &scene,
-            Proposal::CosineHemisphere,
-            n,
-            BATCHES,
-            GatherTarget::Oracle,
-        );
+        let oracle = |config| {
+            summarize(
+                config,
+                &scene,
+                Proposal::CosineHemisphere,
+                n,
+                BATCHES,
+                GatherTarget::Oracle,
+            )
+        };
+        let halton_n_plus_one = oracle(BatchConfig::off());
+        let halton_budget = oracle(BatchConfig {
+            stopping: Stopping::CandidateBudget,
+            ..BatchConfig::off()
+        });
+        let random_n_plus_one = oracle(BatchConfig {
+            placement: Placement::Random,
+            ..BatchConfig::off()
+        });
         let exact = scene.exact();
         println!(
             "n = {n}: Halton n+1 {:+.2}% (z {:+.1}), Halton budget z {:+.1}, random n+1 z {:+.1}",

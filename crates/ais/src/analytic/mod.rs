@@ -9,10 +9,12 @@
 
 mod cap;
 mod gather;
+mod moments;
 mod proposal;
 mod scene;
 
 pub use cap::Cap;
 pub use gather::{gather, GatherTarget};
+pub use moments::Moments;
 pub use proposal::Proposal;
 pub use scene::{Occlusion, Scene, SceneError, Sky, Sun};

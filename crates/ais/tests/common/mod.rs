@@ -1,7 +1,7 @@
 //! Helpers shared by the statistical tests: batch statistics and the chi-square test.
 #![allow(dead_code)]
 
-use ais::analytic::{gather, GatherTarget, Proposal, Scene};
+use ais::analytic::{gather, GatherTarget, Moments, Proposal, Scene};
 use ais::{Batch, BatchConfig, MapStart};
 
 /// The sample mean, variance and mean traced rays of many independent batches.
@@ -57,29 +57,26 @@ pub fn summarize_with(
     start: MapStart,
 ) -> Summary {
     let traced_before = batch.stats().traced;
-    let (mut sum, mut sum_sq) = (0.0, 0.0);
+    let mut moments = Moments::default();
     for seed in 0..batches {
-        let value = gather(
-            batch,
-            scene,
-            proposal,
-            n,
-            1_000_003 * seed as u64 + 17,
-            start,
-            target,
-        )
-        .value;
-        sum += value;
-        sum_sq += value * value;
+        moments.add(
+            gather(
+                batch,
+                scene,
+                proposal,
+                n,
+                1_000_003 * seed as u64 + 17,
+                start,
+                target,
+            )
+            .value,
+        );
     }
-    let count = batches as f64;
-    let mean = sum / count;
-    let variance = (sum_sq / count - mean * mean) * count / (count - 1.0);
     Summary {
-        mean,
-        variance,
-        standard_error: (variance / count).sqrt(),
-        traced: (batch.stats().traced - traced_before) as f64 / count,
+        mean: moments.mean(),
+        variance: moments.variance(),
+        standard_error: moments.standard_error(),
+        traced: (batch.stats().traced - traced_before) as f64 / batches as f64,
     }
 }
 
