@@ -1,0 +1,12 @@
+//! # ais-render: a CPU renderer for studying adaptive importance sampling
+//!
+//! Reads Mitsuba 3 XML scenes (a documented subset) with OBJ, PLY and GLB meshes, builds an
+//! obvhs CWBVH, and renders with a perspective camera onto a box-filtered film written as
+//! EXR plus a tone-mapped PNG preview. Rendering is tiled over rayon with per-pixel seeds,
+//! so images do not depend on the thread count.
+
+pub mod atomic_write;
+pub mod error;
+pub mod scene;
+
+pub use error::InputError;

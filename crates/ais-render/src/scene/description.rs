@@ -1,0 +1,417 @@
+//! The typed scene description: what the renderer needs from a Mitsuba XML file.
+
+use super::properties::Plugin;
+use super::xml;
+use crate::error::InputError;
+use glam::{DMat4, DVec3};
+use std::path::{Path, PathBuf};
+
+/// Which image axis the field of view spans (Mitsuba's `fov_axis`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FovAxis {
+    /// Horizontal.
+    X,
+    /// Vertical.
+    Y,
+    /// The diagonal.
+    Diagonal,
+    /// The shorter side.
+    Smaller,
+    /// The longer side.
+    Larger,
+}
+
+/// A perspective camera.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CameraDescription {
+    /// Camera to world (Mitsuba's convention: +z forward, +y up, +x left).
+    pub to_world: DMat4,
+    /// Field of view in degrees.
+    pub fov_degrees: f64,
+    /// The axis `fov_degrees` spans.
+    pub fov_axis: FovAxis,
+}
+
+/// The mesh file formats.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ.
+    Obj,
+    /// Stanford PLY (ASCII or binary).
+    Ply,
+    /// Binary glTF (our extension to Mitsuba's format).
+    Glb,
+}
+
+/// The geometry of a shape.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeGeometry {
+    /// A sphere (before `to_world`).
+    Sphere {
+        /// Centre.
+        center: DVec3,
+        /// Radius.
+        radius: f64,
+    },
+    /// The square [-1, 1]² at z = 0, normal +z.
+    Rectangle,
+    /// The unit disk at z = 0, normal +z.
+    Disk,
+    /// The cube [-1, 1]³.
+    Cube,
+    /// A mesh file.
+    Mesh {
+        /// Resolved path.
+        path: PathBuf,
+        /// Its format.
+        format: MeshFormat,
+    },
+}
+
+/// A shape with its transform, material and optional area emitter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDescription {
+    /// What it is.
+    pub geometry: ShapeGeometry,
+    /// Object to world.
+    pub to_world: DMat4,
+    /// Mitsuba's `flip_normals`.
+    pub flip_normals: bool,
+    /// Mitsuba's `face_normals`: ignore vertex normals.
+    pub face_normals: bool,
+    /// Index into [`SceneDescription::bsdfs`]; `None` means Mitsuba's default diffuse.
+    pub bsdf: Option<usize>,
+    /// A nested `area` emitter, carried for the lighting code.
+    pub emitter: Option<Plugin>,
+    /// Line of the `<shape>` element.
+    pub line: u32,
+}
+
+/// Everything read from a scene file.
+#[derive(Clone, Debug)]
+pub struct SceneDescription {
+    /// The file it came from.
+    pub file: PathBuf,
+    /// The sensor.
+    pub camera: CameraDescription,
+    /// Film width and height in pixels.
+    pub resolution: (u32, u32),
+    /// The sampler's `sample_count` (samples per pixel).
+    pub sample_count: u32,
+    /// Shapes.
+    pub shapes: Vec<ShapeDescription>,
+    /// BSDFs (top-level with ids, and those nested in shapes), carried for the shading code.
+    pub bsdfs: Vec<Plugin>,
+    /// Scene-level emitters (`envmap`, `constant`, …), carried for the lighting code.
+    pub emitters: Vec<Plugin>,
+    /// The integrator element, if any.
+    pub integrator: Option<Plugin>,
+    /// Non-fatal problems.
+    pub warnings: Vec<String>,
+}
+
+/// Reads a Mitsuba 3 XML scene file. `overrides` set `$param` values (`-D name=value`).
+pub fn load_scene(
+    path: &Path,
+    overrides: &[(String, String)],
+) -> Result<SceneDescription, InputError> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| InputError::new(path, format!("cannot read the scene: {e}")))?;
+    parse_scene(path, &text, overrides)
+}
+
+/// [`load_scene`] on text already read; relative mesh paths resolve against `path`'s folder.
+pub fn parse_scene(
+    path: &Path,
+    text: &str,
+    overrides: &[(String, String)],
+) -> Result<SceneDescription, InputError> {
+    let parsed = xml::parse(path, text, overrides)?;
+    let at = |(line, message): (u32, String)| InputError::at(path, line, message);
+    let mut scene = SceneDescription {
+        file: path.to_path_buf(),
+        camera: CameraDescription {
+            to_world: DMat4::IDENTITY,
+            fov_degrees: 39.3077,
+            fov_axis: FovAxis::X,
+        },
+        resolution: (768, 576),
+        sample_count: 4,
+        shapes: Vec::new(),
+        bsdfs: Vec::new(),
+        emitters: Vec::new(),
+        integrator: None,
+        warnings: parsed.warnings,
+    };
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let mut sensor_seen = false;
+    // BSDFs first so that shapes may reference ones declared after them.
+    for plugin in parsed.plugins.iter().filter(|p| p.tag == "bsdf") {
+        if plugin.id.is_none() {
+            scene.warnings.push(format!(
+                "{}:{}: a top-level <bsdf> without an id can never be used",
+                path.display(),
+                plugin.line
+            ));
+        }
+        scene.bsdfs.push(plugin.clone());
+    }
+    for plugin in &parsed.plugins {
+        match plugin.tag.as_str() {
+            "bsdf" | "texture" => {}
+            "sensor" => {
+                if sensor_seen {
+                    return Err(InputError::at(
+                        path,
+                        plugin.line,
+                        "only one <sensor> is supported",
+                    ));
+                }
+                sensor_seen = true;
+                read_sensor(path, plugin, &mut scene).map_err(at)?;
+            }
+            "shape" => {
+                let shape = read_shape(path, folder, plugin, &mut scene).map_err(at)?;
+                scene.shapes.push(shape);
+            }
+            "emitter" => {
+                if plugin.kind == "area" {
+                    return Err(InputError::at(
+                        path,
+                        plugin.line,
+                        "an area emitter must be nested in a <shape>",
+                    ));
+                }
+                scene.emitters.push(plugin.clone());
+            }
+            "integrator" => scene.integrator = Some(plugin.clone()),
+            other => {
+                return Err(InputError::at(
+                    path,
+                    plugin.line,
+                    format!("<{other}> is not allowed at scene level"),
+                ))
+            }
+        }
+    }
+    if !sensor_seen {
+        scene.warnings.push(format!(
+            "{}: no <sensor>; using Mitsuba's default camera at the origin",
+            path.display()
+        ));
+    }
+    Ok(scene)
+}
+
+fn read_sensor(
+    path: &Path,
+    sensor: &Plugin,
+    scene: &mut SceneDescription,
+) -> Result<(), (u32, String)> {
+    if sensor.kind != "perspective" && sensor.kind != "thinlens" {
+        return Err((
+            sensor.line,
+            format!(
+                "sensor type \"{}\" is not supported (use perspective)",
+                sensor.kind
+            ),
+        ));
+    }
+    if sensor.kind == "thinlens" {
+        scene.warnings.push(format!(
+            "{}:{}: thinlens sensor rendered as a pinhole (perspective)",
+            path.display(),
+            sensor.line
+        ));
+    }
+    let fov = sensor.float("fov", 39.3077)?;
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err((
+            sensor.line,
+            format!("fov must be in (0, 180) degrees, got {fov}"),
+        ));
+    }
+    let fov_axis = match sensor.string("fov_axis")?.unwrap_or("x") {
+        "x" => FovAxis::X,
+        "y" => FovAxis::Y,
+        "diagonal" => FovAxis::Diagonal,
+        "smaller" => FovAxis::Smaller,
+        "larger" => FovAxis::Larger,
+        other => return Err((sensor.line, format!("unknown fov_axis \"{other}\""))),
+    };
+    scene.camera = CameraDescription {
+        to_world: sensor.transform("to_world")?,
+        fov_degrees: fov,
+        fov_axis,
+    };
+    warn_unknown(
+        path,
+        sensor,
+        &[
+            "fov",
+            "fov_axis",
+            "to_world",
+            "near_clip",
+            "far_clip",
+            "focus_distance",
+            "aperture_radius",
+            "focal_length",
+        ],
+        &mut scene.warnings,
+    );
+    for child in &sensor.children {
+        match child.tag.as_str() {
+            "film" => {
+                if child.kind != "hdrfilm" {
+                    return Err((
+                        child.line,
+                        format!(
+                            "film type \"{}\" is not supported (use hdrfilm)",
+                            child.kind
+                        ),
+                    ));
+                }
+                let width = child.integer("width", 768)?;
+                let height = child.integer("height", 576)?;
+                if !(1..=65536).contains(&width) || !(1..=65536).contains(&height) {
+                    return Err((
+                        child.line,
+                        format!("film size {width}×{height} is out of range"),
+                    ));
+                }
+                scene.resolution = (width as u32, height as u32);
+                warn_unknown(
+                    path,
+                    child,
+                    &[
+                        "width",
+                        "height",
+                        "pixel_format",
+                        "component_format",
+                        "file_format",
+                        "rfilter",
+                    ],
+                    &mut scene.warnings,
+                );
+                for filter in &child.children {
+                    if filter.kind != "box" {
+                        scene.warnings.push(format!(
+                            "{}:{}: reconstruction filter \"{}\" replaced by a box filter",
+                            path.display(),
+                            filter.line,
+                            filter.kind
+                        ));
+                    }
+                }
+            }
+            "sampler" => {
+                let count = child.integer("sample_count", 4)?;
+                if count < 1 {
+                    return Err((
+                        child.line,
+                        format!("sample_count must be at least 1, got {count}"),
+                    ));
+                }
+                scene.sample_count = count as u32;
+            }
+            other => return Err((child.line, format!("<{other}> is not allowed in a sensor"))),
+        }
+    }
+    Ok(())
+}
+
+fn read_shape(
+    path: &Path,
+    folder: &Path,
+    shape: &Plugin,
+    scene: &mut SceneDescription,
+) -> Result<ShapeDescription, (u32, String)> {
+    let mesh = |format: MeshFormat| -> Result<ShapeGeometry, (u32, String)> {
+        let name = shape.string("filename")?.ok_or((
+            shape.line,
+            format!("shape \"{}\" needs a \"filename\" string", shape.kind),
+        ))?;
+        Ok(ShapeGeometry::Mesh {
+            path: folder.join(name),
+            format,
+        })
+    };
+    let (geometry, known): (ShapeGeometry, &[&str]) = match shape.kind.as_str() {
+        "sphere" => {
+            let radius = shape.float("radius", 1.0)?;
+            if !(radius > 0.0 && radius.is_finite()) {
+                return Err((shape.line, format!("sphere radius must be positive, got {radius}")));
+            }
+            (
+                ShapeGeometry::Sphere {
+                    center: shape.point("center", DVec3::ZERO)?,
+                    radius,
+                },
+                &["radius", "center", "to_world", "flip_normals"],
+            )
+        }
+        "rectangle" => (ShapeGeometry::Rectangle, &["to_world", "flip_normals"]),
+        "disk" => (ShapeGeometry::Disk, &["to_world", "flip_normals"]),
+        "cube" => (ShapeGeometry::Cube, &["to_world", "flip_normals"]),
+        "obj" => (mesh(MeshFormat::Obj)?, &["filename", "to_world", "flip_normals", "face_normals", "flip_tex_coords"]),
+        "ply" => (mesh(MeshFormat::Ply)?, &["filename", "to_world", "flip_normals", "face_normals"]),
+        "glb" | "gltf" => (mesh(MeshFormat::Glb)?, &["filename", "to_world", "flip_normals", "face_normals"]),
+        other => return Err((shape.line, format!("shape type \"{other}\" is not supported (obj, ply, glb, sphere, rectangle, disk, cube)"))),
+    };
+    warn_unknown(path, shape, known, &mut scene.warnings);
+    let mut bsdf = None;
+    let mut emitter = None;
+    for (_, id, line) in &shape.references {
+        let index = scene
+            .bsdfs
+            .iter()
+            .position(|b| b.id.as_deref() == Some(id.as_str()))
+            .ok_or((*line, format!("no <bsdf> with id \"{id}\"")))?;
+        if bsdf.replace(index).is_some() {
+            return Err((*line, "a shape can have only one bsdf".into()));
+        }
+    }
+    for child in &shape.children {
+        match child.tag.as_str() {
+            "bsdf" => {
+                scene.bsdfs.push(child.clone());
+                if bsdf.replace(scene.bsdfs.len() - 1).is_some() {
+                    return Err((child.line, "a shape can have only one bsdf".into()));
+                }
+            }
+            "emitter" => {
+                if child.kind != "area" {
+                    return Err((
+                        child.line,
+                        format!(
+                            "a shape can only carry an area emitter, not \"{}\"",
+                            child.kind
+                        ),
+                    ));
+                }
+                emitter = Some(child.clone());
+            }
+            other => return Err((child.line, format!("<{other}> is not allowed in a shape"))),
+        }
+    }
+    Ok(ShapeDescription {
+        geometry,
+        to_world: shape.transform("to_world")?,
+        flip_normals: shape.boolean("flip_normals", false)?,
+        face_normals: shape.boolean("face_normals", false)?,
+        bsdf,
+        emitter,
+        line: shape.line,
+    })
+}
+
+fn warn_unknown(path: &Path, plugin: &Plugin, known: &[&str], warnings: &mut Vec<String>) {
+    for (name, line) in plugin.unknown_properties(known) {
+        warnings.push(format!(
+            "{}:{line}: property \"{name}\" of {} \"{}\" is ignored",
+            path.display(),
+            plugin.tag,
+            plugin.kind
+        ));
+    }
+}

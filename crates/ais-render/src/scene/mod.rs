@@ -1,0 +1,12 @@
+//! Scene files: the Mitsuba 3 XML subset we read, and the typed description built from it.
+
+mod description;
+mod properties;
+mod xml;
+
+pub use description::{
+    load_scene, parse_scene, CameraDescription, FovAxis, MeshFormat, SceneDescription,
+    ShapeDescription, ShapeGeometry,
+};
+pub use properties::{LocatedProperty, Plugin, Property};
+pub use xml::look_at;

@@ -1,0 +1,374 @@
+//! Reading Mitsuba 3 XML into [`Plugin`] trees: `$param` substitution, property tags and
+//! transforms. Interpretation of the plugins happens in [`super::description`].
+
+use super::properties::{LocatedProperty, Plugin, Property};
+use crate::error::InputError;
+use glam::{DMat4, DVec3};
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+/// Tags that introduce a nested plugin.
+const PLUGIN_TAGS: &[&str] = &[
+    "shape",
+    "bsdf",
+    "emitter",
+    "sensor",
+    "film",
+    "sampler",
+    "texture",
+    "integrator",
+    "rfilter",
+];
+
+/// Tags of Mitsuba that this reader refuses with a clear error rather than ignore.
+const UNSUPPORTED_TAGS: &[&str] = &["medium", "phase", "volume", "spectrum", "include", "alias"];
+
+/// The children of the root `<scene>`, after substitution.
+pub struct ParsedScene {
+    /// Top-level plugins, in file order.
+    pub plugins: Vec<Plugin>,
+    /// Non-fatal problems, each naming the file and line.
+    pub warnings: Vec<String>,
+}
+
+struct Reader<'a> {
+    file: &'a Path,
+    text: &'a str,
+    parameters: HashMap<String, String>,
+    warnings: Vec<String>,
+}
+
+/// Parses the Mitsuba XML in `text` (read from `file`). `overrides` set `$param` values and
+/// take precedence over `<default>` elements.
+pub fn parse(
+    file: &Path,
+    text: &str,
+    overrides: &[(String, String)],
+) -> Result<ParsedScene, InputError> {
+    let document = roxmltree::Document::parse(text).map_err(|e| {
+        let position = e.pos();
+        InputError::at(file, position.row, format!("malformed XML: {e}"))
+    })?;
+    let root = document.root_element();
+    let mut reader = Reader {
+        file,
+        text,
+        parameters: overrides.iter().cloned().collect(),
+        warnings: Vec::new(),
+    };
+    if root.tag_name().name() != "scene" {
+        return Err(reader.error(
+            root,
+            format!(
+                "the root element must be <scene>, found <{}>",
+                root.tag_name().name()
+            ),
+        ));
+    }
+    // Defaults first, wherever they are, so that they apply to the whole file.
+    for child in root.children().filter(|n| n.is_element()) {
+        if child.tag_name().name() == "default" {
+            let name = reader.raw_attribute(child, "name")?;
+            let value = reader.raw_attribute(child, "value")?;
+            reader
+                .parameters
+                .entry(name.to_string())
+                .or_insert_with(|| value.to_string());
+        }
+    }
+    let mut plugins = Vec::new();
+    for child in root.children().filter(|n| n.is_element()) {
+        let tag = child.tag_name().name();
+        if tag == "default" {
+            continue;
+        }
+        if PLUGIN_TAGS.contains(&tag) {
+            plugins.push(reader.plugin(child)?);
+        } else if tag == "ref" {
+            return Err(reader.error(child, "a <ref> at scene level refers to nothing"));
+        } else {
+            return Err(reader.unexpected(child, "<scene>"));
+        }
+    }
+    Ok(ParsedScene {
+        plugins,
+        warnings: reader.warnings,
+    })
+}
+
+impl<'a> Reader<'a> {
+    fn line(&self, node: roxmltree::Node) -> u32 {
+        self.text[..node.range().start].matches('\n').count() as u32 + 1
+    }
+
+    fn error(&self, node: roxmltree::Node, message: impl Into<String>) -> InputError {
+        InputError::at(self.file, self.line(node), message)
+    }
+
+    fn unexpected(&self, node: roxmltree::Node, parent: &str) -> InputError {
+        let tag = node.tag_name().name();
+        if UNSUPPORTED_TAGS.contains(&tag) {
+            self.error(node, format!("<{tag}> is not supported by ais"))
+        } else {
+            self.error(node, format!("unexpected element <{tag}> in {parent}"))
+        }
+    }
+
+    fn raw_attribute<'n>(
+        &self,
+        node: roxmltree::Node<'n, 'n>,
+        name: &str,
+    ) -> Result<&'n str, InputError> {
+        node.attribute(name).ok_or_else(|| {
+            self.error(
+                node,
+                format!("<{}> needs a \"{name}\" attribute", node.tag_name().name()),
+            )
+        })
+    }
+
+    /// An attribute with `$param` references substituted.
+    fn attribute(&self, node: roxmltree::Node, name: &str) -> Result<String, InputError> {
+        let raw = self.raw_attribute(node, name)?;
+        self.substitute(node, raw)
+    }
+
+    fn optional_attribute(
+        &self,
+        node: roxmltree::Node,
+        name: &str,
+    ) -> Result<Option<String>, InputError> {
+        node.attribute(name)
+            .map(|raw| self.substitute(node, raw))
+            .transpose()
+    }
+
+    fn substitute(&self, node: roxmltree::Node, raw: &str) -> Result<String, InputError> {
+        let mut out = String::with_capacity(raw.len());
+        let mut rest = raw;
+        while let Some(start) = rest.find('$') {
+            out.push_str(&rest[..start]);
+            let after = &rest[start + 1..];
+            let end = after
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .unwrap_or(after.len());
+            let name = &after[..end];
+            if name.is_empty() {
+                return Err(self.error(node, format!("a lone '$' in \"{raw}\"")));
+            }
+            let value = self.parameters.get(name).ok_or_else(|| {
+                self.error(
+                    node,
+                    format!(
+                        "parameter ${name} has no <default> and was not given on the command line"
+                    ),
+                )
+            })?;
+            out.push_str(value);
+            rest = &after[end..];
+        }
+        out.push_str(rest);
+        Ok(out)
+    }
+
+    fn plugin(&mut self, node: roxmltree::Node) -> Result<Plugin, InputError> {
+        let tag = node.tag_name().name().to_string();
+        let kind = self.attribute(node, "type")?;
+        let mut plugin = Plugin {
+            tag: tag.clone(),
+            kind,
+            id: self.optional_attribute(node, "id")?,
+            name: self.optional_attribute(node, "name")?,
+            properties: BTreeMap::new(),
+            children: Vec::new(),
+            references: Vec::new(),
+            line: self.line(node),
+        };
+        for child in node.children().filter(|n| n.is_element()) {
+            let child_tag = child.tag_name().name();
+            if PLUGIN_TAGS.contains(&child_tag) {
+                plugin.children.push(self.plugin(child)?);
+            } else if child_tag == "ref" {
+                let id = self.attribute(child, "id")?;
+                let name = self.optional_attribute(child, "name")?;
+                plugin.references.push((name, id, self.line(child)));
+            } else if child_tag == "default" {
+                return Err(self.error(child, "<default> must be a direct child of <scene>"));
+            } else {
+                let name = self.attribute(child, "name")?;
+                let value = self.property(child)?;
+                let line = self.line(child);
+                if plugin.properties.contains_key(&name) {
+                    self.warnings.push(format!(
+                        "{}:{line}: property \"{name}\" given twice; the last one wins",
+                        self.file.display()
+                    ));
+                }
+                plugin
+                    .properties
+                    .insert(name, LocatedProperty { value, line });
+            }
+        }
+        Ok(plugin)
+    }
+
+    fn numbers(&self, node: roxmltree::Node, text: &str) -> Result<Vec<f64>, InputError> {
+        text.split(|c: char| c == ',' || c.is_whitespace())
+            .filter(|s| !s.is_empty())
+            .map(|s| {
+                s.parse::<f64>()
+                    .map_err(|_| self.error(node, format!("\"{s}\" is not a number")))
+            })
+            .collect()
+    }
+
+    fn number(&self, node: roxmltree::Node, text: &str) -> Result<f64, InputError> {
+        match self.numbers(node, text)?.as_slice() {
+            [v] => Ok(*v),
+            _ => Err(self.error(node, format!("expected one number, got \"{text}\""))),
+        }
+    }
+
+    /// A 3-vector from `x`, `y`, `z` attributes (missing ones default to `fill`) or `value`.
+    fn vector3(
+        &self,
+        node: roxmltree::Node,
+        attribute: &str,
+        fill: f64,
+    ) -> Result<DVec3, InputError> {
+        if let Some(text) = self.optional_attribute(node, attribute)? {
+            return match self.numbers(node, &text)?.as_slice() {
+                [v] => Ok(DVec3::splat(*v)),
+                [x, y, z] => Ok(DVec3::new(*x, *y, *z)),
+                _ => Err(self.error(
+                    node,
+                    format!("\"{attribute}\" needs 1 or 3 numbers, got \"{text}\""),
+                )),
+            };
+        }
+        let mut v = [fill; 3];
+        let mut any = false;
+        for (slot, axis) in v.iter_mut().zip(["x", "y", "z"]) {
+            if let Some(text) = self.optional_attribute(node, axis)? {
+                *slot = self.number(node, &text)?;
+                any = true;
+            }
+        }
+        if !any {
+            return Err(self.error(
+                node,
+                format!("<{}> needs x, y, z or {attribute}", node.tag_name().name()),
+            ));
+        }
+        Ok(DVec3::from_array(v))
+    }
+
+    fn property(&self, node: roxmltree::Node) -> Result<Property, InputError> {
+        let tag = node.tag_name().name();
+        let value = || self.attribute(node, "value");
+        Ok(match tag {
+            "float" => Property::Float(self.number(node, &value()?)?),
+            "integer" => {
+                let text = value()?;
+                Property::Integer(
+                    text.trim()
+                        .parse()
+                        .map_err(|_| self.error(node, format!("\"{text}\" is not an integer")))?,
+                )
+            }
+            "boolean" => match value()?.trim() {
+                "true" => Property::Boolean(true),
+                "false" => Property::Boolean(false),
+                other => return Err(self.error(node, format!("\"{other}\" is not true or false"))),
+            },
+            "string" => Property::String(value()?),
+            "rgb" => {
+                let text = value()?;
+                match self.numbers(node, &text)?.as_slice() {
+                    [v] => Property::Rgb([*v; 3]),
+                    [r, g, b] => Property::Rgb([*r, *g, *b]),
+                    _ => {
+                        return Err(
+                            self.error(node, format!("<rgb> needs 1 or 3 numbers, got \"{text}\""))
+                        )
+                    }
+                }
+            }
+            "point" => Property::Point(self.vector3(node, "value", 0.0)?),
+            "vector" => Property::Vector(self.vector3(node, "value", 0.0)?),
+            "transform" => Property::Transform(self.transform(node)?),
+            _ => return Err(self.unexpected(node, "a plugin")),
+        })
+    }
+
+    /// Composes the operations of a `<transform>`: each later one is applied after the earlier.
+    fn transform(&self, node: roxmltree::Node) -> Result<DMat4, InputError> {
+        let mut matrix = DMat4::IDENTITY;
+        for op in node.children().filter(|n| n.is_element()) {
+            let step = match op.tag_name().name() {
+                "translate" => DMat4::from_translation(self.vector3(op, "value", 0.0)?),
+                "scale" => DMat4::from_scale(self.vector3(op, "value", 1.0)?),
+                "rotate" => {
+                    let axis = self.vector3(op, "value", 0.0)?;
+                    let angle = self.number(op, &self.attribute(op, "angle")?)?;
+                    if axis.length_squared() == 0.0 {
+                        return Err(self.error(op, "<rotate> needs a non-zero axis"));
+                    }
+                    DMat4::from_axis_angle(axis.normalize(), angle.to_radians())
+                }
+                "matrix" => {
+                    let text = self.attribute(op, "value")?;
+                    let v = self.numbers(op, &text)?;
+                    match v.len() {
+                        16 => DMat4::from_cols_array(&[
+                            v[0], v[4], v[8], v[12], v[1], v[5], v[9], v[13], v[2], v[6], v[10],
+                            v[14], v[3], v[7], v[11], v[15],
+                        ]),
+                        9 => DMat4::from_cols_array(&[
+                            v[0], v[3], v[6], 0.0, v[1], v[4], v[7], 0.0, v[2], v[5], v[8], 0.0,
+                            0.0, 0.0, 0.0, 1.0,
+                        ]),
+                        n => {
+                            return Err(
+                                self.error(op, format!("<matrix> needs 9 or 16 numbers, got {n}"))
+                            )
+                        }
+                    }
+                }
+                "lookat" => {
+                    let origin = self.vector3(op, "origin", 0.0)?;
+                    let target = self.vector3(op, "target", 0.0)?;
+                    let up = match op.attribute("up") {
+                        Some(_) => self.vector3(op, "up", 0.0)?,
+                        None => DVec3::Y,
+                    };
+                    look_at(origin, target, up).ok_or_else(|| {
+                        self.error(
+                            op,
+                            "<lookat> has target = origin or up parallel to the view direction",
+                        )
+                    })?
+                }
+                _ => return Err(self.unexpected(op, "<transform>")),
+            };
+            matrix = step * matrix;
+        }
+        if !matrix.is_finite() || matrix.determinant().abs() < 1e-300 {
+            return Err(self.error(node, "the transform is singular or not finite"));
+        }
+        Ok(matrix)
+    }
+}
+
+/// Mitsuba's look-at: camera +z toward the target, +y up, +x to the left.
+pub fn look_at(origin: DVec3, target: DVec3, up: DVec3) -> Option<DMat4> {
+    let direction = (target - origin).try_normalize()?;
+    let left = up.cross(direction).try_normalize()?;
+    let new_up = direction.cross(left);
+    Some(DMat4::from_cols(
+        left.extend(0.0),
+        new_up.extend(0.0),
+        direction.extend(0.0),
+        origin.extend(1.0),
+    ))
+}
