@@ -6,7 +6,17 @@
 //! so images do not depend on the thread count.
 
 pub mod atomic_write;
+pub mod camera;
+pub mod default_scene;
 pub mod error;
+pub mod film;
+pub mod geometry;
+pub mod image_io;
+pub mod integrator;
+pub mod mesh;
+pub mod render;
 pub mod scene;
+pub mod shapes;
+pub mod world;
 
 pub use error::InputError;

@@ -1,0 +1,253 @@
+//! Scene geometry: triangle meshes and spheres in an obvhs CWBVH, with closest-hit and
+//! occlusion queries.
+
+mod primitive;
+mod ray;
+
+pub use primitive::{Primitive, Sphere, Triangle};
+pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
+
+use crate::mesh::TriangleMesh;
+use glam::{Vec2, Vec3, Vec3A};
+use obvhs::cwbvh::CwBvh;
+use std::time::{Duration, Instant};
+
+/// What one shape contributes, in world space.
+#[derive(Clone, Debug)]
+pub enum ShapeGeometry {
+    /// A triangle mesh.
+    Mesh(TriangleMesh),
+    /// An analytic sphere.
+    Sphere(Sphere),
+}
+
+/// A shape for [`Geometry::build`].
+#[derive(Clone, Debug)]
+pub struct ShapeInput {
+    /// The geometry, in world space.
+    pub geometry: ShapeGeometry,
+    /// Whether to flip its normals (Mitsuba's `flip_normals`).
+    pub flip_normals: bool,
+}
+
+/// A ray-surface intersection.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Distance along the ray.
+    pub t: f32,
+    /// World-space point.
+    pub point: Vec3,
+    /// Unit geometric normal (flipped if the shape says so).
+    pub geometric_normal: Vec3,
+    /// Unit shading normal (interpolated vertex normals, else the geometric normal).
+    pub shading_normal: Vec3,
+    /// Index of the shape (in the order given to [`Geometry::build`]).
+    pub shape: u32,
+}
+
+/// Per-mesh data needed to shade a triangle hit.
+#[derive(Clone, Debug)]
+struct MeshShading {
+    normals: Option<Vec<Vec3>>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// The scene's primitives in a CWBVH.
+pub struct Geometry {
+    /// Primitives in BVH order (the BVH's primitive index is the position here).
+    primitives: Vec<Primitive>,
+    /// The shape of each primitive, in the same order.
+    primitive_shapes: Vec<u32>,
+    meshes: Vec<MeshShading>,
+    shape_flips: Vec<bool>,
+    bvh: Option<CwBvh>,
+    triangle_count: usize,
+    build_time: Duration,
+}
+
+impl Geometry {
+    /// Builds the BVH over all shapes.
+    pub fn build(shapes: Vec<ShapeInput>) -> Self {
+        let started = Instant::now();
+        let mut primitives = Vec::new();
+        let mut primitive_shapes = Vec::new();
+        let mut meshes = Vec::new();
+        let mut shape_flips = Vec::new();
+        let mut triangle_count = 0;
+        for (shape_index, shape) in shapes.into_iter().enumerate() {
+            shape_flips.push(shape.flip_normals);
+            match shape.geometry {
+                ShapeGeometry::Sphere(sphere) => {
+                    primitives.push(Primitive::Sphere(sphere));
+                    primitive_shapes.push(shape_index as u32);
+                }
+                ShapeGeometry::Mesh(mesh) => {
+                    let mesh_index = meshes.len() as u32;
+                    for (index, &[a, b, c]) in mesh.triangles.iter().enumerate() {
+                        primitives.push(Primitive::Triangle(Triangle {
+                            vertices: [
+                                mesh.positions[a as usize],
+                                mesh.positions[b as usize],
+                                mesh.positions[c as usize],
+                            ],
+                            mesh: mesh_index,
+                            index: index as u32,
+                        }));
+                        primitive_shapes.push(shape_index as u32);
+                    }
+                    triangle_count += mesh.triangles.len();
+                    meshes.push(MeshShading {
+                        normals: mesh.normals,
+                        triangles: mesh.triangles,
+                    });
+                }
+            }
+        }
+        let bvh = (!primitives.is_empty()).then(|| {
+            obvhs::cwbvh::builder::build_cwbvh(
+                &primitives,
+                obvhs::BvhBuildParams::medium_build(),
+                &mut Duration::default(),
+            )
+        });
+        // Reorder primitives into BVH order so traversal needs no indirection.
+        if let Some(bvh) = &bvh {
+            primitives = bvh
+                .primitive_indices
+                .iter()
+                .map(|&i| primitives[i as usize])
+                .collect();
+            primitive_shapes = bvh
+                .primitive_indices
+                .iter()
+                .map(|&i| primitive_shapes[i as usize])
+                .collect();
+        }
+        Geometry {
+            primitives,
+            primitive_shapes,
+            meshes,
+            shape_flips,
+            bvh,
+            triangle_count,
+            build_time: started.elapsed(),
+        }
+    }
+
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.triangle_count
+    }
+
+    /// Number of primitives (triangles and spheres).
+    pub fn primitive_count(&self) -> usize {
+        self.primitives.len()
+    }
+
+    /// Wall time of [`Geometry::build`].
+    pub fn build_time(&self) -> Duration {
+        self.build_time
+    }
+
+    fn bvh_ray(ray: &Ray) -> obvhs::ray::Ray {
+        obvhs::ray::Ray::new(
+            Vec3A::from(ray.origin),
+            Vec3A::from(ray.direction),
+            0.0,
+            ray.t_max,
+        )
+    }
+
+    #[inline]
+    fn intersect_primitive(&self, index: usize, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
+        match &self.primitives[index] {
+            Primitive::Triangle(t) => t.intersect(ray, t_max),
+            Primitive::Sphere(s) => s.intersect(ray, t_max).map(|t| (t, Vec2::ZERO)),
+        }
+    }
+
+    /// The closest hit along the ray, if any.
+    pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
+        let bvh = self.bvh.as_ref()?;
+        let mut best: Option<(usize, f32, Vec2)> = None;
+        let mut hit = obvhs::ray::RayHit::none();
+        bvh.ray_traverse(Self::bvh_ray(ray), &mut hit, |r, id| {
+            match self.intersect_primitive(id, ray, r.tmax) {
+                Some((t, barycentrics)) => {
+                    best = Some((id, t, barycentrics));
+                    t
+                }
+                None => f32::INFINITY,
+            }
+        });
+        best.map(|(index, t, barycentrics)| self.shade(index, ray, t, barycentrics))
+    }
+
+    /// The closest hit by testing every primitive: the reference the BVH is tested against.
+    pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
+        let mut best: Option<(usize, f32, Vec2)> = None;
+        for index in 0..self.primitives.len() {
+            let t_max = best.map_or(ray.t_max, |b| b.1);
+            if let Some((t, barycentrics)) = self.intersect_primitive(index, ray, t_max) {
+                best = Some((index, t, barycentrics));
+            }
+        }
+        best.map(|(index, t, barycentrics)| self.shade(index, ray, t, barycentrics))
+    }
+
+    /// Whether anything blocks the ray before `t_max` (any-hit query).
+    pub fn occluded(&self, ray: &Ray) -> bool {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        !bvh.ray_traverse_miss(Self::bvh_ray(ray), |r, id| {
+            self.intersect_primitive(id, ray, r.tmax)
+                .map_or(f32::INFINITY, |(t, _)| t)
+        })
+    }
+
+    fn shade(&self, index: usize, ray: &Ray, t: f32, barycentrics: Vec2) -> Hit {
+        let point = ray.at(t);
+        let shape = self.primitive_shapes[index];
+        let flip = if self.shape_flips[shape as usize] {
+            -1.0
+        } else {
+            1.0
+        };
+        let (geometric_normal, shading_normal) = match &self.primitives[index] {
+            Primitive::Sphere(s) => {
+                let n = (point - s.center).normalize() * flip;
+                (n, n)
+            }
+            Primitive::Triangle(triangle) => {
+                let n = triangle.normal().normalize() * flip;
+                let mesh = &self.meshes[triangle.mesh as usize];
+                let shading = match &mesh.normals {
+                    Some(normals) => {
+                        let [a, b, c] = mesh.triangles[triangle.index as usize];
+                        let interpolated = normals[a as usize]
+                            * (1.0 - barycentrics.x - barycentrics.y)
+                            + normals[b as usize] * barycentrics.x
+                            + normals[c as usize] * barycentrics.y;
+                        // Vertex normals were already flipped with the mesh.
+                        let s = interpolated.normalize_or_zero();
+                        if s == Vec3::ZERO {
+                            n
+                        } else {
+                            s
+                        }
+                    }
+                    None => n,
+                };
+                (n, shading)
+            }
+        };
+        Hit {
+            t,
+            point,
+            geometric_normal,
+            shading_normal,
+            shape,
+        }
+    }
+}

@@ -1,0 +1,108 @@
+//! The primitives the BVH holds: triangles and spheres, with exact intersection.
+
+use super::ray::Ray;
+use glam::{Vec2, Vec3};
+
+/// A triangle of a mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    /// Vertices.
+    pub vertices: [Vec3; 3],
+    /// Index of its mesh in [`super::Geometry`], and of its first vertex normal there.
+    pub mesh: u32,
+    /// Index of the triangle in its mesh.
+    pub index: u32,
+}
+
+/// A sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    /// Centre.
+    pub center: Vec3,
+    /// Radius.
+    pub radius: f32,
+}
+
+/// One primitive of the scene, with the shape it belongs to.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Primitive {
+    /// A triangle.
+    Triangle(Triangle),
+    /// A sphere.
+    Sphere(Sphere),
+}
+
+impl Triangle {
+    /// Möller-Trumbore: the distance and barycentrics (b1, b2) of the hit, if within the ray.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
+        let [v0, v1, v2] = self.vertices;
+        let e1 = v1 - v0;
+        let e2 = v2 - v0;
+        let p = ray.direction.cross(e2);
+        let determinant = e1.dot(p);
+        if determinant.abs() < 1e-20 {
+            return None;
+        }
+        let inverse = 1.0 / determinant;
+        let s = ray.origin - v0;
+        let b1 = s.dot(p) * inverse;
+        if !(0.0..=1.0).contains(&b1) {
+            return None;
+        }
+        let q = s.cross(e1);
+        let b2 = ray.direction.dot(q) * inverse;
+        if b2 < 0.0 || b1 + b2 > 1.0 {
+            return None;
+        }
+        let t = e2.dot(q) * inverse;
+        (t > 0.0 && t < t_max).then_some((t, Vec2::new(b1, b2)))
+    }
+
+    /// The unnormalised geometric normal (e1 × e2), oriented by the winding.
+    pub fn normal(&self) -> Vec3 {
+        let [v0, v1, v2] = self.vertices;
+        (v1 - v0).cross(v2 - v0)
+    }
+}
+
+impl Sphere {
+    /// The nearest hit distance within the ray, if any (the far hit when starting inside).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        // Solve in a numerically careful form: project the centre onto the ray first.
+        let to_center = self.center - ray.origin;
+        let along = to_center.dot(ray.direction);
+        let closest = to_center - along * ray.direction;
+        let discriminant = self.radius * self.radius - closest.length_squared();
+        if discriminant < 0.0 {
+            return None;
+        }
+        let half_chord = discriminant.sqrt();
+        let near = along - half_chord;
+        let far = along + half_chord;
+        if near > 0.0 && near < t_max {
+            Some(near)
+        } else if far > 0.0 && far < t_max {
+            Some(far)
+        } else {
+            None
+        }
+    }
+}
+
+impl obvhs::Boundable for Primitive {
+    fn aabb(&self) -> obvhs::aabb::Aabb {
+        match self {
+            Primitive::Triangle(t) => {
+                let [a, b, c] = t.vertices.map(glam::Vec3A::from);
+                obvhs::aabb::Aabb::new(a.min(b).min(c), a.max(b).max(c))
+            }
+            Primitive::Sphere(s) => {
+                let c = glam::Vec3A::from(s.center);
+                let r = glam::Vec3A::splat(s.radius);
+                obvhs::aabb::Aabb::new(c - r, c + r)
+            }
+        }
+    }
+}

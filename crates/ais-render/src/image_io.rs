@@ -1,0 +1,176 @@
+//! RGB float images: reading EXR (exr crate) and Radiance HDR (image crate) with
+//! sanitising, and writing EXR (32-bit float RGB) and a tone-mapped sRGB PNG preview.
+
+use crate::atomic_write::write_atomically;
+use crate::error::InputError;
+use std::path::Path;
+
+/// A linear RGB image, row-major from the top-left pixel.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RgbImage {
+    /// Width in pixels.
+    pub width: usize,
+    /// Height in pixels.
+    pub height: usize,
+    /// `width * height` pixels.
+    pub pixels: Vec<[f32; 3]>,
+}
+
+/// An image read from a file, with the texels that had to be sanitised.
+#[derive(Clone, Debug)]
+pub struct LoadedImage {
+    /// The image, every channel finite and non-negative.
+    pub image: RgbImage,
+    /// A warning naming the file and counting the channels clamped to 0, if any were.
+    pub warning: Option<String>,
+}
+
+impl RgbImage {
+    /// A black image.
+    pub fn new(width: usize, height: usize) -> Self {
+        RgbImage {
+            width,
+            height,
+            pixels: vec![[0.0; 3]; width * height],
+        }
+    }
+
+    /// Replaces NaN, infinite and negative channels by 0; returns how many there were.
+    pub fn sanitize(&mut self) -> usize {
+        let mut count = 0;
+        for channel in self.pixels.iter_mut().flatten() {
+            if !(channel.is_finite() && *channel >= 0.0) {
+                *channel = 0.0;
+                count += 1;
+            }
+        }
+        count
+    }
+}
+
+/// Reads an `.exr` or `.hdr` file into linear RGB, sanitising bad texels.
+pub fn read_image(path: &Path) -> Result<LoadedImage, InputError> {
+    if !path.exists() {
+        return Err(InputError::new(path, "image file not found"));
+    }
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let mut image = match extension.as_deref() {
+        Some("exr") => read_exr(path)?,
+        Some("hdr") => read_hdr(path)?,
+        _ => {
+            return Err(InputError::new(
+                path,
+                "unsupported image format: use .exr or .hdr",
+            ))
+        }
+    };
+    let bad = image.sanitize();
+    let warning = (bad > 0).then(|| {
+        format!(
+            "{}: {bad} texel channel(s) were NaN, infinite or negative and were clamped to 0",
+            path.display()
+        )
+    });
+    Ok(LoadedImage { image, warning })
+}
+
+fn read_exr(path: &Path) -> Result<RgbImage, InputError> {
+    let result = exr::prelude::read_first_rgba_layer_from_file(
+        path,
+        |resolution, _| RgbImage::new(resolution.width(), resolution.height()),
+        |image: &mut RgbImage, position, (r, g, b, _a): (f32, f32, f32, f32)| {
+            let index = position.y() * image.width + position.x();
+            image.pixels[index] = [r, g, b];
+        },
+    )
+    .map_err(|e| InputError::new(path, format!("cannot read EXR: {e}")))?;
+    Ok(result.layer_data.channel_data.pixels)
+}
+
+fn read_hdr(path: &Path) -> Result<RgbImage, InputError> {
+    let decoded = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| InputError::new(path, format!("cannot open HDR: {e}")))?
+        .decode()
+        .map_err(|e| InputError::new(path, format!("cannot read HDR: {e}")))?
+        .into_rgb32f();
+    Ok(RgbImage {
+        width: decoded.width() as usize,
+        height: decoded.height() as usize,
+        pixels: decoded.pixels().map(|p| p.0).collect(),
+    })
+}
+
+/// An error while writing an output image.
+#[derive(Debug)]
+pub struct WriteError(pub String);
+
+impl From<std::io::Error> for WriteError {
+    fn from(e: std::io::Error) -> Self {
+        WriteError(e.to_string())
+    }
+}
+
+impl std::fmt::Display for WriteError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for WriteError {}
+
+/// Writes 32-bit float RGB EXR atomically. Refuses images with non-finite pixels.
+pub fn write_exr(path: &Path, image: &RgbImage) -> Result<(), WriteError> {
+    if let Some(index) = image
+        .pixels
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        return Err(WriteError(format!(
+            "{}: pixel ({}, {}) is not finite; refusing to write",
+            path.display(),
+            index % image.width,
+            index / image.width
+        )));
+    }
+    write_atomically(path, |temporary| {
+        exr::prelude::write_rgb_file(temporary, image.width, image.height, |x, y| {
+            let p = image.pixels[y * image.width + x];
+            (p[0], p[1], p[2])
+        })
+        .map_err(|e| WriteError(format!("{}: cannot write EXR: {e}", path.display())))
+    })
+}
+
+/// The sRGB transfer function of a linear value in [0, 1].
+fn srgb_encode(linear: f32) -> f32 {
+    if linear <= 0.003_130_8 {
+        12.92 * linear
+    } else {
+        1.055 * linear.powf(1.0 / 2.4) - 0.055
+    }
+}
+
+/// Writes an 8-bit sRGB PNG preview atomically: pixels scaled by 2^`exposure`, clamped.
+pub fn write_png(path: &Path, image: &RgbImage, exposure: f32) -> Result<(), WriteError> {
+    let scale = exposure.exp2();
+    let bytes: Vec<u8> = image
+        .pixels
+        .iter()
+        .flat_map(|p| p.map(|c| (srgb_encode((c * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
+        .collect();
+    write_atomically(path, |temporary| {
+        image::save_buffer_with_format(
+            temporary,
+            &bytes,
+            image.width as u32,
+            image.height as u32,
+            image::ExtendedColorType::Rgb8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| WriteError(format!("{}: cannot write PNG: {e}", path.display())))
+    })
+}

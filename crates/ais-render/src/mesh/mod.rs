@@ -1,0 +1,142 @@
+//! Triangle meshes and their readers (OBJ, PLY, GLB).
+
+mod glb;
+mod obj;
+mod ply;
+
+use crate::error::InputError;
+use crate::scene::MeshFormat;
+use glam::{DMat4, Vec3};
+use std::path::Path;
+
+/// An indexed triangle mesh with optional per-vertex shading normals.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    /// Vertex positions.
+    pub positions: Vec<Vec3>,
+    /// Per-vertex normals (same length as `positions`), if the file had them.
+    pub normals: Option<Vec<Vec3>>,
+    /// Triangles as vertex indices.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// A mesh read from a file, with the problems found that did not stop the read.
+#[derive(Clone, Debug)]
+pub struct LoadedMesh {
+    /// The mesh, validated: finite positions, indices in range, no degenerate triangles.
+    pub mesh: TriangleMesh,
+    /// Non-fatal problems (e.g. degenerate triangles dropped), naming the file.
+    pub warnings: Vec<String>,
+}
+
+/// Reads a mesh file of the given format.
+pub fn load_mesh(path: &Path, format: MeshFormat) -> Result<LoadedMesh, InputError> {
+    if !path.exists() {
+        return Err(InputError::new(path, "mesh file not found"));
+    }
+    let mesh = match format {
+        MeshFormat::Obj => obj::read(path)?,
+        MeshFormat::Ply => ply::read(path)?,
+        MeshFormat::Glb => glb::read(path)?,
+    };
+    validate(path, mesh)
+}
+
+/// Checks a mesh: positions finite, indices in range, normals usable; degenerate triangles
+/// (zero area) are dropped with a warning; an empty result is an error.
+pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, InputError> {
+    let mut warnings = Vec::new();
+    if let Some(index) = mesh.positions.iter().position(|p| !p.is_finite()) {
+        return Err(InputError::new(
+            path,
+            format!("vertex {index} has a non-finite position"),
+        ));
+    }
+    let count = mesh.positions.len() as u32;
+    if let Some((t, _)) = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .find(|(_, tri)| tri.iter().any(|&i| i >= count))
+    {
+        return Err(InputError::new(
+            path,
+            format!("triangle {t} refers to a vertex beyond the {count} vertices"),
+        ));
+    }
+    if let Some(normals) = &mesh.normals {
+        if normals.len() != mesh.positions.len() || normals.iter().any(|n| !n.is_finite()) {
+            warnings.push(format!(
+                "{}: vertex normals are incomplete or not finite; using face normals",
+                path.display()
+            ));
+            mesh.normals = None;
+        }
+    }
+    let before = mesh.triangles.len();
+    let positions = &mesh.positions;
+    mesh.triangles.retain(|&[a, b, c]| {
+        let (a, b, c) = (
+            positions[a as usize],
+            positions[b as usize],
+            positions[c as usize],
+        );
+        (b - a).cross(c - a).length_squared() > 0.0
+    });
+    let dropped = before - mesh.triangles.len();
+    if dropped > 0 {
+        warnings.push(format!(
+            "{}: dropped {dropped} degenerate (zero-area) triangle(s) of {before}",
+            path.display()
+        ));
+    }
+    if mesh.triangles.is_empty() {
+        return Err(InputError::new(
+            path,
+            if before == 0 {
+                "the mesh has no triangles".to_string()
+            } else {
+                "every triangle of the mesh is degenerate".to_string()
+            },
+        ));
+    }
+    Ok(LoadedMesh { mesh, warnings })
+}
+
+impl TriangleMesh {
+    /// Applies an object-to-world transform; normals use the inverse transpose. With
+    /// `face_normals` the vertex normals are discarded; with `flip_normals` they are negated
+    /// (face normals are flipped by the geometry that uses the mesh).
+    pub fn transformed(mut self, to_world: DMat4, face_normals: bool, flip_normals: bool) -> Self {
+        let m = to_world.as_mat4();
+        let normal_matrix = to_world.inverse().transpose().as_mat4();
+        for p in &mut self.positions {
+            *p = m.transform_point3(*p);
+        }
+        if face_normals {
+            self.normals = None;
+        }
+        if let Some(normals) = &mut self.normals {
+            for n in normals.iter_mut() {
+                let t = normal_matrix.transform_vector3(*n).normalize_or_zero();
+                *n = if flip_normals { -t } else { t };
+            }
+        }
+        self
+    }
+
+    /// Total surface area.
+    pub fn area(&self) -> f64 {
+        self.triangles
+            .iter()
+            .map(|&[a, b, c]| {
+                let (a, b, c) = (
+                    self.positions[a as usize],
+                    self.positions[b as usize],
+                    self.positions[c as usize],
+                );
+                0.5 * (b - a).cross(c - a).length() as f64
+            })
+            .sum()
+    }
+}

@@ -1,0 +1,47 @@
+//! Wavefront OBJ, through tobj.
+
+use super::TriangleMesh;
+use crate::error::InputError;
+use glam::Vec3;
+use std::path::Path;
+
+/// Reads every object of an OBJ file into one mesh (polygons are triangulated).
+pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
+    let options = tobj::LoadOptions {
+        triangulate: true,
+        single_index: true,
+        ..Default::default()
+    };
+    let (models, _) = tobj::load_obj(path, &options)
+        .map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
+    let mut mesh = TriangleMesh::default();
+    let mut all_have_normals = true;
+    let mut normals = Vec::new();
+    for model in &models {
+        let m = &model.mesh;
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(
+            m.positions
+                .chunks_exact(3)
+                .map(|p| Vec3::new(p[0], p[1], p[2])),
+        );
+        if m.normals.len() == m.positions.len() && !m.normals.is_empty() {
+            normals.extend(
+                m.normals
+                    .chunks_exact(3)
+                    .map(|n| Vec3::new(n[0], n[1], n[2])),
+            );
+        } else {
+            all_have_normals = false;
+        }
+        mesh.triangles.extend(
+            m.indices
+                .chunks_exact(3)
+                .map(|t| [base + t[0], base + t[1], base + t[2]]),
+        );
+    }
+    if all_have_normals && !normals.is_empty() {
+        mesh.normals = Some(normals);
+    }
+    Ok(mesh)
+}

@@ -1,0 +1,77 @@
+//! Stanford PLY (ASCII and binary), through ply-rs-bw.
+
+use super::TriangleMesh;
+use crate::error::InputError;
+use glam::Vec3;
+use ply_rs_bw::parser::Parser;
+use ply_rs_bw::ply::{DefaultElement, Property};
+use std::path::Path;
+
+fn scalar(element: &DefaultElement, name: &str) -> Option<f32> {
+    element.get(name).and_then(Property::to_f32_lossy)
+}
+
+/// Reads the `vertex` (x, y, z and optional nx, ny, nz) and `face` (vertex_indices or
+/// vertex_index; polygons are fanned into triangles) elements.
+pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
+    let file = std::fs::File::open(path)
+        .map_err(|e| InputError::new(path, format!("cannot open PLY: {e}")))?;
+    let mut reader = std::io::BufReader::new(file);
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut reader)
+        .map_err(|e| InputError::new(path, format!("cannot read PLY: {e}")))?;
+    let vertices = ply
+        .payload
+        .get("vertex")
+        .ok_or_else(|| InputError::new(path, "PLY has no \"vertex\" element"))?;
+    let mut mesh = TriangleMesh::default();
+    let mut normals = Vec::with_capacity(vertices.len());
+    for (index, vertex) in vertices.iter().enumerate() {
+        let coordinate = |name| {
+            scalar(vertex, name).ok_or_else(|| {
+                InputError::new(
+                    path,
+                    format!("PLY vertex {index} has no numeric \"{name}\""),
+                )
+            })
+        };
+        mesh.positions.push(Vec3::new(
+            coordinate("x")?,
+            coordinate("y")?,
+            coordinate("z")?,
+        ));
+        if let (Some(x), Some(y), Some(z)) = (
+            scalar(vertex, "nx"),
+            scalar(vertex, "ny"),
+            scalar(vertex, "nz"),
+        ) {
+            normals.push(Vec3::new(x, y, z));
+        }
+    }
+    if normals.len() == mesh.positions.len() && !normals.is_empty() {
+        mesh.normals = Some(normals);
+    }
+    let faces = ply
+        .payload
+        .get("face")
+        .ok_or_else(|| InputError::new(path, "PLY has no \"face\" element"))?;
+    for (index, face) in faces.iter().enumerate() {
+        let list = face
+            .get("vertex_indices")
+            .or_else(|| face.get("vertex_index"))
+            .and_then(Property::to_u32_list)
+            .ok_or_else(|| {
+                InputError::new(path, format!("PLY face {index} has no vertex_indices list"))
+            })?;
+        if list.len() < 3 {
+            return Err(InputError::new(
+                path,
+                format!("PLY face {index} has fewer than 3 vertices"),
+            ));
+        }
+        for k in 1..list.len() - 1 {
+            mesh.triangles.push([list[0], list[k], list[k + 1]]);
+        }
+    }
+    Ok(mesh)
+}

@@ -1,0 +1,110 @@
+//! Parallel tiled rendering with per-pixel seeds: the image does not depend on the number
+//! of threads or on scheduling.
+
+use crate::film::Film;
+use crate::image_io::RgbImage;
+use crate::integrator::{Integrator, RayCounts};
+use crate::world::World;
+use ais::rng::{mix64, Pcg32};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use rayon::prelude::*;
+use std::time::{Duration, Instant};
+
+/// Edge length of a square tile, in pixels.
+pub const TILE_SIZE: usize = 16;
+
+/// Render settings.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderSettings {
+    /// Samples per pixel.
+    pub samples_per_pixel: u32,
+    /// What to compute.
+    pub integrator: Integrator,
+    /// Base seed; each pixel derives its own from it.
+    pub seed: u64,
+    /// Show a progress bar on stderr (it also hides itself when stderr is not a terminal).
+    pub progress: bool,
+}
+
+/// A finished render.
+pub struct RenderOutput {
+    /// The image.
+    pub image: RgbImage,
+    /// Rays traced.
+    pub rays: RayCounts,
+    /// Wall time of the render loop.
+    pub time: Duration,
+}
+
+/// The seed of pixel (x, y) of a `width`-wide image.
+pub fn pixel_seed(seed: u64, x: usize, y: usize, width: usize) -> u64 {
+    mix64(seed ^ mix64((y * width + x) as u64))
+}
+
+/// Renders `world` with `settings` on the current rayon pool.
+pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
+    let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
+    let tiles: Vec<(usize, usize)> = (0..height.div_ceil(TILE_SIZE))
+        .flat_map(|ty| {
+            (0..width.div_ceil(TILE_SIZE)).map(move |tx| (tx * TILE_SIZE, ty * TILE_SIZE))
+        })
+        .collect();
+    let progress = if settings.progress {
+        let bar =
+            ProgressBar::with_draw_target(Some(tiles.len() as u64), ProgressDrawTarget::stderr());
+        bar.set_style(
+            ProgressStyle::with_template(
+                "{spinner} rendering [{bar:40}] {pos}/{len} tiles, {elapsed} elapsed, ETA {eta}",
+            )
+            .expect("valid template")
+            .progress_chars("=> "),
+        );
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let started = Instant::now();
+    let results: Vec<(usize, usize, Vec<[f32; 3]>, RayCounts)> = tiles
+        .par_iter()
+        .map(|&(x0, y0)| {
+            let mut counts = RayCounts::default();
+            let mut pixels = Vec::with_capacity(TILE_SIZE * TILE_SIZE);
+            for y in y0..(y0 + TILE_SIZE).min(height) {
+                for x in x0..(x0 + TILE_SIZE).min(width) {
+                    let mut rng = Pcg32::new(pixel_seed(settings.seed, x, y, width), 0);
+                    let mut sum = [0.0f64; 3];
+                    for _ in 0..settings.samples_per_pixel {
+                        let u = (x as f32 + rng.next_f32()) / width as f32;
+                        let v = (y as f32 + rng.next_f32()) / height as f32;
+                        let ray = world.camera.ray(u, v);
+                        let value =
+                            settings
+                                .integrator
+                                .radiance(world, &ray, &mut rng, &mut counts);
+                        for (s, c) in sum.iter_mut().zip(value) {
+                            *s += c as f64;
+                        }
+                    }
+                    pixels.push(sum.map(|s| (s / settings.samples_per_pixel as f64) as f32));
+                }
+            }
+            progress.inc(1);
+            (x0, y0, pixels, counts)
+        })
+        .collect();
+    progress.finish_and_clear();
+    let mut film = Film::new(width, height);
+    let mut rays = RayCounts::default();
+    for (x0, y0, pixels, counts) in results {
+        rays.merge(counts);
+        let tile_width = (x0 + TILE_SIZE).min(width) - x0;
+        for (i, value) in pixels.into_iter().enumerate() {
+            film.add(x0 + i % tile_width, y0 + i / tile_width, value);
+        }
+    }
+    RenderOutput {
+        image: film.image(),
+        rays,
+        time: started.elapsed(),
+    }
+}
