@@ -1,0 +1,209 @@
+//! Intersections against analytic answers, the BVH against brute force, and ray offsets.
+
+use ais::rng::Pcg32;
+use ais_render::geometry::{spawn_ray, Geometry, Ray, ShapeGeometry, ShapeInput, Sphere, Triangle};
+use ais_render::mesh::TriangleMesh;
+use ais_render::shapes;
+use glam::{DMat4, DVec3, Vec3};
+
+fn random_unit(rng: &mut Pcg32) -> Vec3 {
+    let z = 1.0 - 2.0 * rng.next_f32();
+    let phi = std::f32::consts::TAU * rng.next_f32();
+    let r = (1.0 - z * z).sqrt();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+#[test]
+fn triangle_hit_distance_and_barycentrics() {
+    let triangle = Triangle {
+        vertices: [Vec3::ZERO, Vec3::X, Vec3::Y],
+        mesh: 0,
+        index: 0,
+    };
+    let ray = Ray::new(Vec3::new(0.25, 0.5, 3.0), Vec3::NEG_Z);
+    let (t, b) = triangle.intersect(&ray, f32::INFINITY).unwrap();
+    assert!((t - 3.0).abs() < 1e-6);
+    assert!((b.x - 0.25).abs() < 1e-6 && (b.y - 0.5).abs() < 1e-6);
+    assert!(triangle.intersect(&ray, 2.5).is_none(), "beyond t_max");
+    let outside = Ray::new(Vec3::new(0.75, 0.5, 3.0), Vec3::NEG_Z);
+    assert!(triangle.intersect(&outside, f32::INFINITY).is_none());
+    let behind = Ray::new(Vec3::new(0.25, 0.25, -1.0), Vec3::NEG_Z);
+    assert!(triangle.intersect(&behind, f32::INFINITY).is_none());
+}
+
+#[test]
+fn sphere_hits_match_the_quadratic() {
+    let sphere = Sphere {
+        center: Vec3::new(0.0, 0.0, 10.0),
+        radius: 2.0,
+    };
+    let ray = Ray::new(Vec3::ZERO, Vec3::Z);
+    assert!((sphere.intersect(&ray, f32::INFINITY).unwrap() - 8.0).abs() < 1e-5);
+    // Grazing offset 1: the chord half-length is sqrt(3).
+    let offset = Ray::new(Vec3::new(1.0, 0.0, 0.0), Vec3::Z);
+    assert!(
+        (sphere.intersect(&offset, f32::INFINITY).unwrap() - (10.0 - 3f32.sqrt())).abs() < 1e-5
+    );
+    // From inside, the far hit.
+    let inside = Ray::new(Vec3::new(0.0, 0.0, 10.0), Vec3::X);
+    assert!((sphere.intersect(&inside, f32::INFINITY).unwrap() - 2.0).abs() < 1e-6);
+    assert!(sphere
+        .intersect(&Ray::new(Vec3::ZERO, Vec3::NEG_Z), f32::INFINITY)
+        .is_none());
+}
+
+#[test]
+fn rectangle_from_mitsuba_transform() {
+    // Mitsuba's rectangle scaled by 2 and moved to z = 5: it covers [-2, 2]² there.
+    let to_world =
+        DMat4::from_translation(DVec3::new(0.0, 0.0, 5.0)) * DMat4::from_scale(DVec3::splat(2.0));
+    let mesh = shapes::rectangle().transformed(to_world, false, false);
+    let geometry = Geometry::build(vec![ShapeInput {
+        geometry: ShapeGeometry::Mesh(mesh),
+        flip_normals: false,
+    }]);
+    let hit = geometry
+        .intersect(&Ray::new(Vec3::new(1.9, -1.9, 0.0), Vec3::Z))
+        .unwrap();
+    assert!((hit.t - 5.0).abs() < 1e-5);
+    assert!((hit.geometric_normal - Vec3::Z).length() < 1e-6);
+    assert!(geometry
+        .intersect(&Ray::new(Vec3::new(2.1, 0.0, 0.0), Vec3::Z))
+        .is_none());
+    let flipped = Geometry::build(vec![ShapeInput {
+        geometry: ShapeGeometry::Mesh(shapes::rectangle().transformed(to_world, false, true)),
+        flip_normals: true,
+    }]);
+    let hit = flipped.intersect(&Ray::new(Vec3::ZERO, Vec3::Z)).unwrap();
+    assert!((hit.geometric_normal + Vec3::Z).length() < 1e-6);
+}
+
+/// Random triangles and spheres in a box.
+fn random_scene(rng: &mut Pcg32) -> Geometry {
+    let mut mesh = TriangleMesh::default();
+    for t in 0..2000u32 {
+        let center = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
+        for _ in 0..3 {
+            mesh.positions.push(center + random_unit(rng) * 0.6);
+        }
+        mesh.triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
+    }
+    let mut shapes = vec![ShapeInput {
+        geometry: ShapeGeometry::Mesh(mesh),
+        flip_normals: false,
+    }];
+    for _ in 0..50 {
+        shapes.push(ShapeInput {
+            geometry: ShapeGeometry::Sphere(Sphere {
+                center: Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0,
+                radius: 0.1 + 0.4 * rng.next_f32(),
+            }),
+            flip_normals: false,
+        });
+    }
+    Geometry::build(shapes)
+}
+
+#[test]
+fn bvh_agrees_with_brute_force_on_random_rays() {
+    let mut rng = Pcg32::new(31, 7);
+    let geometry = random_scene(&mut rng);
+    let mut hits = 0;
+    for i in 0..5000 {
+        let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0;
+        let mut ray = Ray::new(origin, random_unit(&mut rng));
+        if i % 3 == 0 {
+            ray.t_max = 3.0 * rng.next_f32();
+        }
+        let fast = geometry.intersect(&ray);
+        let slow = geometry.intersect_brute_force(&ray);
+        match (fast, slow) {
+            (Some(a), Some(b)) => {
+                assert!(
+                    (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
+                    "ray {i}: {} vs {}",
+                    a.t,
+                    b.t
+                );
+                assert_eq!(a.shape, b.shape, "ray {i}");
+                hits += 1;
+            }
+            (None, None) => {}
+            (a, b) => panic!("ray {i}: BVH {a:?} vs brute force {b:?}"),
+        }
+        assert_eq!(
+            geometry.occluded(&ray),
+            slow.is_some(),
+            "ray {i}: occlusion query"
+        );
+    }
+    assert!(hits > 1000, "the test must exercise hits: {hits}");
+}
+
+#[test]
+fn offset_rays_do_not_hit_the_surface_they_leave() {
+    // A large sphere and a tilted, far-from-origin triangle: leaving the surface outward must
+    // never hit the same surface (acne).
+    let mut rng = Pcg32::new(8, 8);
+    let sphere = Sphere {
+        center: Vec3::new(100.0, -50.0, 30.0),
+        radius: 20.0,
+    };
+    let mut mesh = TriangleMesh::default();
+    mesh.positions = vec![
+        Vec3::new(500.0, 500.0, 500.0),
+        Vec3::new(530.0, 480.0, 510.0),
+        Vec3::new(505.0, 530.0, 470.0),
+    ];
+    mesh.triangles = vec![[0, 1, 2]];
+    let geometry = Geometry::build(vec![
+        ShapeInput {
+            geometry: ShapeGeometry::Sphere(sphere),
+            flip_normals: false,
+        },
+        ShapeInput {
+            geometry: ShapeGeometry::Mesh(mesh),
+            flip_normals: false,
+        },
+    ]);
+    let mut tested = 0;
+    for _ in 0..20_000 {
+        // A camera-like ray that hits something, then a ray leaving it on the normal's side.
+        let target = if rng.next_f32() < 0.5 {
+            sphere.center + random_unit(&mut rng) * sphere.radius
+        } else {
+            let (a, b) = (rng.next_f32(), rng.next_f32());
+            let (a, b) = if a + b > 1.0 {
+                (1.0 - a, 1.0 - b)
+            } else {
+                (a, b)
+            };
+            Vec3::new(500.0, 500.0, 500.0) * (1.0 - a - b)
+                + Vec3::new(530.0, 480.0, 510.0) * a
+                + Vec3::new(505.0, 530.0, 470.0) * b
+        };
+        let origin = target + random_unit(&mut rng) * 200.0;
+        let Some(hit) = geometry.intersect(&Ray::new(origin, (target - origin).normalize())) else {
+            continue;
+        };
+        let facing = if hit.geometric_normal.dot(origin - hit.point) > 0.0 {
+            hit.geometric_normal
+        } else {
+            -hit.geometric_normal
+        };
+        let mut direction = random_unit(&mut rng);
+        if direction.dot(facing) < 0.0 {
+            direction = -direction;
+        }
+        let leaving = spawn_ray(hit.point, facing, direction);
+        if let Some(again) = geometry.intersect(&leaving) {
+            assert!(
+                again.shape != hit.shape || again.t > 1e-2,
+                "self-intersection at t = {}",
+                again.t
+            );
+        }
+        tested += 1;
+    }
+    assert!(tested > 10_000);
+}

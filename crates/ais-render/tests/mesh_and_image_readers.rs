@@ -1,0 +1,230 @@
+//! Mesh and image readers on files the tests generate.
+
+use ais_render::image_io::{read_image, write_exr, RgbImage};
+use ais_render::mesh::load_mesh;
+use ais_render::scene::MeshFormat;
+use glam::Vec3;
+use std::path::PathBuf;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ais-readers-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir.join(name)
+}
+
+#[test]
+fn obj_with_normals_and_a_quad() {
+    let path = scratch("quad.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvn 0 0 1\nf 1//1 2//1 3//1 4//1\n",
+    )
+    .unwrap();
+    let loaded = load_mesh(&path, MeshFormat::Obj).unwrap();
+    assert_eq!(loaded.mesh.triangles.len(), 2);
+    assert!((loaded.mesh.area() - 1.0).abs() < 1e-6);
+    assert!(loaded
+        .mesh
+        .normals
+        .as_ref()
+        .unwrap()
+        .iter()
+        .all(|&n| n == Vec3::Z));
+}
+
+#[test]
+fn obj_errors_name_the_file() {
+    let path = scratch("broken.obj");
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nf 1 2 7\n").unwrap();
+    let e = load_mesh(&path, MeshFormat::Obj).unwrap_err();
+    assert!(e.to_string().contains("broken.obj"), "{e}");
+    let missing = load_mesh(&scratch("missing.obj"), MeshFormat::Obj).unwrap_err();
+    assert!(missing.to_string().contains("not found"), "{missing}");
+    let empty = scratch("empty.obj");
+    std::fs::write(&empty, "v 0 0 0\n").unwrap();
+    assert!(load_mesh(&empty, MeshFormat::Obj)
+        .unwrap_err()
+        .to_string()
+        .contains("no triangles"));
+}
+
+#[test]
+fn degenerate_triangles_are_dropped_with_a_warning() {
+    let path = scratch("degenerate.obj");
+    std::fs::write(
+        &path,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n",
+    )
+    .unwrap();
+    let loaded = load_mesh(&path, MeshFormat::Obj).unwrap();
+    assert_eq!(loaded.mesh.triangles.len(), 1);
+    assert!(
+        loaded.warnings[0].contains("dropped 1 degenerate"),
+        "{:?}",
+        loaded.warnings
+    );
+    let all_bad = scratch("all_degenerate.obj");
+    std::fs::write(&all_bad, "v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n").unwrap();
+    let e = load_mesh(&all_bad, MeshFormat::Obj).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("every triangle of the mesh is degenerate"),
+        "{e}"
+    );
+}
+
+const PLY_HEADER: &str = "ply\nformat {FORMAT} 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
+
+#[test]
+fn ply_ascii_and_binary() {
+    let ascii = scratch("quad_ascii.ply");
+    std::fs::write(
+        &ascii,
+        PLY_HEADER.replace("{FORMAT}", "ascii") + "0 0 0\n2 0 0\n2 2 0\n0 2 0\n4 0 1 2 3\n",
+    )
+    .unwrap();
+    let loaded = load_mesh(&ascii, MeshFormat::Ply).unwrap();
+    assert_eq!(loaded.mesh.triangles.len(), 2);
+    assert!((loaded.mesh.area() - 4.0).abs() < 1e-6);
+
+    let binary = scratch("quad_binary.ply");
+    let mut bytes = PLY_HEADER
+        .replace("{FORMAT}", "binary_little_endian")
+        .into_bytes();
+    for v in [
+        [0.0f32, 0.0, 0.0],
+        [3.0, 0.0, 0.0],
+        [3.0, 3.0, 0.0],
+        [0.0, 3.0, 0.0],
+    ] {
+        for c in v {
+            bytes.extend(c.to_le_bytes());
+        }
+    }
+    bytes.push(4);
+    for i in [0i32, 1, 2, 3] {
+        bytes.extend(i.to_le_bytes());
+    }
+    std::fs::write(&binary, bytes).unwrap();
+    let loaded = load_mesh(&binary, MeshFormat::Ply).unwrap();
+    assert!((loaded.mesh.area() - 9.0).abs() < 1e-6);
+
+    let truncated = scratch("truncated.ply");
+    std::fs::write(
+        &truncated,
+        PLY_HEADER.replace("{FORMAT}", "ascii") + "0 0 0\n",
+    )
+    .unwrap();
+    let e = load_mesh(&truncated, MeshFormat::Ply).unwrap_err();
+    assert!(e.to_string().contains("truncated.ply"), "{e}");
+}
+
+/// A minimal GLB: one triangle, optionally declaring Draco compression.
+fn glb(draco: bool) -> Vec<u8> {
+    let mut bin = Vec::new();
+    for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+        for c in v {
+            bin.extend(c.to_le_bytes());
+        }
+    }
+    let extensions = if draco {
+        r#""extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],"#
+    } else {
+        ""
+    };
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},{extensions}"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"translation":[0,0,2]}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"buffers":[{{"byteLength":36}}],"bufferViews":[{{"buffer":0,"byteLength":36}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}]}}"#
+    );
+    let mut json = json.into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::new();
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(bin);
+    out
+}
+
+#[test]
+fn glb_plain_and_draco() {
+    let plain = scratch("triangle.glb");
+    std::fs::write(&plain, glb(false)).unwrap();
+    let loaded = load_mesh(&plain, MeshFormat::Glb).unwrap();
+    assert_eq!(loaded.mesh.triangles.len(), 1);
+    assert!(
+        loaded.mesh.positions.iter().all(|p| p.z == 2.0),
+        "node transform applied"
+    );
+    let draco = scratch("draco.glb");
+    std::fs::write(&draco, glb(true)).unwrap();
+    let e = load_mesh(&draco, MeshFormat::Glb).unwrap_err().to_string();
+    assert!(
+        e.contains("KHR_draco_mesh_compression") && e.contains("draco.glb"),
+        "{e}"
+    );
+}
+
+#[test]
+fn exr_round_trip_and_sanitising() {
+    let path = scratch("image.exr");
+    let mut image = RgbImage::new(3, 2);
+    image.pixels[4] = [1.5, 0.25, 8.0];
+    write_exr(&path, &image).unwrap();
+    let loaded = read_image(&path).unwrap();
+    assert_eq!(loaded.image, image);
+    assert!(loaded.warning.is_none());
+
+    // A file with NaN, infinite and negative texels, written directly with the exr crate.
+    let bad = scratch("bad.exr");
+    exr::prelude::write_rgb_file(&bad, 2, 1, |x, _| match x {
+        0 => (f32::NAN, -3894.0, 1.0),
+        _ => (f32::INFINITY, 0.5, 2.0),
+    })
+    .unwrap();
+    let loaded = read_image(&bad).unwrap();
+    assert_eq!(loaded.image.pixels, vec![[0.0, 0.0, 1.0], [0.0, 0.5, 2.0]]);
+    assert!(loaded.warning.unwrap().contains("3 texel channel(s)"));
+}
+
+#[test]
+fn exr_writer_refuses_nan_and_keeps_the_old_file() {
+    let path = scratch("keep.exr");
+    let good = RgbImage::new(2, 2);
+    write_exr(&path, &good).unwrap();
+    let mut bad = RgbImage::new(2, 2);
+    bad.pixels[1][0] = f32::NAN;
+    let e = write_exr(&path, &bad).unwrap_err();
+    assert!(e.to_string().contains("pixel (1, 0) is not finite"), "{e}");
+    assert_eq!(read_image(&path).unwrap().image, good);
+}
+
+#[test]
+fn radiance_hdr_is_read() {
+    let path = scratch("image.hdr");
+    let pixels = vec![image::Rgb([0.5f32, 1.0, 2.0]); 4];
+    let file = std::fs::File::create(&path).unwrap();
+    image::codecs::hdr::HdrEncoder::new(file)
+        .encode(&pixels, 2, 2)
+        .unwrap();
+    let loaded = read_image(&path).unwrap();
+    assert_eq!((loaded.image.width, loaded.image.height), (2, 2));
+    assert!(loaded
+        .image
+        .pixels
+        .iter()
+        .all(|p| (p[2] - 2.0).abs() < 0.02 && (p[0] - 0.5).abs() < 0.01));
+    let unknown = scratch("image.png");
+    std::fs::write(&unknown, b"x").unwrap();
+    assert!(read_image(&unknown)
+        .unwrap_err()
+        .to_string()
+        .contains("unsupported image format"));
+}

@@ -1,0 +1,189 @@
+//! End-to-end rendering: scene files with meshes, thread-count independence, and a real
+//! model from npm (the Stanford bunny).
+
+use ais_render::default_scene::default_world;
+use ais_render::integrator::Integrator;
+use ais_render::render::{render, RenderSettings};
+use ais_render::scene::load_scene;
+use ais_render::world::World;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("ais-render-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn settings(integrator: Integrator, spp: u32) -> RenderSettings {
+    RenderSettings {
+        samples_per_pixel: spp,
+        integrator,
+        seed: 5,
+        progress: false,
+    }
+}
+
+#[test]
+fn images_are_bit_identical_at_one_and_two_threads() {
+    let world = default_world(48, 27);
+    let ao = Integrator::AmbientOcclusion {
+        rays: 4,
+        distance: 1.0,
+    };
+    let render_with = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| render(&world, &settings(ao, 2)))
+    };
+    let one = render_with(1);
+    let two = render_with(2);
+    let bits = |image: &ais_render::image_io::RgbImage| -> Vec<u32> {
+        image.pixels.iter().flatten().map(|c| c.to_bits()).collect()
+    };
+    assert_eq!(bits(&one.image), bits(&two.image));
+    assert_eq!(one.rays, two.rays);
+    // The image is not trivially uniform: the sculpture occludes.
+    let min = one.image.pixels.iter().map(|p| p[0]).fold(1.0, f32::min);
+    assert!(min < 0.5, "some pixels must be occluded, min {min}");
+}
+
+/// A scene file with a mesh in front of the camera.
+fn write_scene(dir: &Path, shape: &str) -> PathBuf {
+    let scene = dir.join("scene.xml");
+    std::fs::write(
+        &scene,
+        format!(
+            r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <float name="fov" value="30"/>
+        <transform name="to_world"><lookat origin="0, 0, 6" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="32"/></film>
+        <sampler type="independent"><integer name="sample_count" value="1"/></sampler>
+    </sensor>
+    {shape}
+</scene>"#
+        ),
+    )
+    .unwrap();
+    scene
+}
+
+#[test]
+fn an_xml_scene_with_an_obj_mesh_renders() {
+    let dir = scratch("obj");
+    std::fs::write(
+        dir.join("quad.obj"),
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let scene = write_scene(
+        &dir,
+        r#"<shape type="obj"><string name="filename" value="quad.obj"/></shape>"#,
+    );
+    let world = World::from_description(load_scene(&scene, &[]).unwrap()).unwrap();
+    assert_eq!(world.geometry.triangle_count(), 2);
+    let output = render(&world, &settings(Integrator::Normals, 1));
+    // Centre pixel: the quad's normal +z maps to (0.5, 0.5, 1); a corner misses (black).
+    let centre = output.image.pixels[16 * 32 + 16];
+    assert!(
+        (centre[2] - 1.0).abs() < 1e-3 && (centre[0] - 0.5).abs() < 1e-3,
+        "{centre:?}"
+    );
+    assert_eq!(output.image.pixels[0], [0.0; 3]);
+}
+
+#[test]
+fn a_missing_mesh_is_an_error_naming_the_file() {
+    let dir = scratch("missing");
+    let scene = write_scene(
+        &dir,
+        r#"<shape type="ply"><string name="filename" value="nowhere.ply"/></shape>"#,
+    );
+    let e = World::from_description(load_scene(&scene, &[]).unwrap())
+        .err()
+        .unwrap();
+    assert!(
+        e.to_string().contains("nowhere.ply") && e.to_string().contains("not found"),
+        "{e}"
+    );
+}
+
+/// Parses the bunny package's `exports.positions=[[x,y,z],…]` and `exports.cells=[[a,b,c],…]`.
+fn bunny_obj(index_js: &str) -> Option<String> {
+    let numbers = |name: &str| -> Option<Vec<f64>> {
+        let start = index_js.find(&format!("exports.{name}="))? + name.len() + 9;
+        let rest = &index_js[start..];
+        let end = rest.find("\nexports").unwrap_or(rest.len());
+        rest[..end]
+            .split(|c: char| c == '[' || c == ']' || c == ',' || c.is_whitespace() || c == ';')
+            .filter(|s| !s.is_empty())
+            .map(|s| s.parse().ok())
+            .collect()
+    };
+    let positions = numbers("positions")?;
+    let cells = numbers("cells")?;
+    let mut obj = String::new();
+    for p in positions.chunks_exact(3) {
+        obj += &format!("v {} {} {}\n", p[0], p[1], p[2]);
+    }
+    for c in cells.chunks_exact(3) {
+        obj += &format!("f {} {} {}\n", c[0] + 1.0, c[1] + 1.0, c[2] + 1.0);
+    }
+    Some(obj)
+}
+
+/// Prints a skip reason where the test harness does not swallow it.
+fn skip(reason: &str) {
+    let _ = writeln!(std::io::stderr(), "SKIPPED the npm bunny test: {reason}");
+}
+
+#[test]
+fn the_stanford_bunny_from_npm_loads_and_renders() {
+    let dir = scratch("bunny");
+    let pack = Command::new("npm")
+        .args(["pack", "bunny@1.0.1", "--silent", "--pack-destination"])
+        .arg(&dir)
+        .output();
+    match pack {
+        Err(e) => return skip(&format!("npm could not be run ({e})")),
+        Ok(out) if !out.status.success() => {
+            return skip(&format!(
+                "`npm pack bunny` failed: {}",
+                String::from_utf8_lossy(&out.stderr).trim()
+            ))
+        }
+        Ok(_) => {}
+    }
+    let untar = Command::new("tar")
+        .args(["xzf", "bunny-1.0.1.tgz"])
+        .current_dir(&dir)
+        .status()
+        .expect("tar runs");
+    assert!(untar.success(), "the npm tarball must unpack");
+    let index = std::fs::read_to_string(dir.join("package/index.js")).unwrap();
+    let obj = bunny_obj(&index).expect("the bunny package has positions and cells");
+    std::fs::write(dir.join("bunny.obj"), obj).unwrap();
+    let scene = write_scene(
+        &dir,
+        r#"<shape type="obj"><string name="filename" value="bunny.obj"/>
+           <transform name="to_world"><translate y="-5"/><scale value="0.25"/></transform></shape>"#,
+    );
+    let world = World::from_description(load_scene(&scene, &[]).unwrap()).unwrap();
+    // The npm bunny is the 1,839-vertex, 3,674-triangle low-resolution Stanford bunny.
+    assert_eq!(world.geometry.triangle_count(), 3674);
+    let output = render(&world, &settings(Integrator::Normals, 1));
+    let covered = output
+        .image
+        .pixels
+        .iter()
+        .filter(|p| p.iter().any(|&c| c > 0.0))
+        .count();
+    assert!(
+        covered > 100 && covered < 32 * 32,
+        "bunny covers {covered} of 1024 pixels"
+    );
+}

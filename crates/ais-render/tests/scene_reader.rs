@@ -1,0 +1,200 @@
+//! The Mitsuba XML reader on hand-written scenes, including every error path.
+
+use ais_render::scene::{parse_scene, FovAxis, Property, ShapeGeometry};
+use glam::{DMat4, DVec3};
+use std::path::Path;
+
+fn parse(text: &str) -> Result<ais_render::scene::SceneDescription, ais_render::InputError> {
+    parse_scene(Path::new("/scenes/test.xml"), text, &[])
+}
+
+fn error(text: &str) -> String {
+    let e = parse(text).expect_err("the scene should be refused");
+    assert_eq!(
+        e.file,
+        Path::new("/scenes/test.xml"),
+        "the error names the file"
+    );
+    e.to_string()
+}
+
+const FULL: &str = r#"<?xml version="1.0"?>
+<scene version="3.0.0">
+    <default name="spp" value="64"/>
+    <default name="res" value="320"/>
+    <integrator type="direct"/>
+    <sensor type="perspective">
+        <float name="fov" value="45"/>
+        <string name="fov_axis" value="y"/>
+        <transform name="to_world">
+            <lookat origin="0, 1, 5" target="0, 0, 0" up="0, 1, 0"/>
+        </transform>
+        <film type="hdrfilm">
+            <integer name="width" value="$res"/>
+            <integer name="height" value="240"/>
+        </film>
+        <sampler type="independent">
+            <integer name="sample_count" value="$spp"/>
+        </sampler>
+    </sensor>
+    <bsdf type="diffuse" id="grey">
+        <rgb name="reflectance" value="0.5, 0.5, 0.5"/>
+    </bsdf>
+    <shape type="obj">
+        <string name="filename" value="meshes/bunny.obj"/>
+        <boolean name="face_normals" value="true"/>
+        <ref id="grey"/>
+    </shape>
+    <shape type="sphere">
+        <point name="center" x="1" y="2" z="3"/>
+        <float name="radius" value="0.5"/>
+        <emitter type="area"><rgb name="radiance" value="10"/></emitter>
+    </shape>
+    <shape type="rectangle">
+        <transform name="to_world">
+            <scale value="2"/>
+            <rotate x="1" angle="90"/>
+            <translate x="1" y="0" z="0"/>
+        </transform>
+        <boolean name="flip_normals" value="true"/>
+        <bsdf type="roughconductor"/>
+    </shape>
+    <shape type="disk"/>
+    <shape type="cube"/>
+    <shape type="ply"><string name="filename" value="a.ply"/></shape>
+    <shape type="glb"><string name="filename" value="b.glb"/></shape>
+    <emitter type="envmap">
+        <string name="filename" value="sky.exr"/>
+        <float name="scale" value="2"/>
+    </emitter>
+</scene>"#;
+
+#[test]
+fn a_full_scene_is_read() {
+    let scene = parse(FULL).unwrap();
+    assert_eq!(scene.resolution, (320, 240));
+    assert_eq!(scene.sample_count, 64);
+    assert_eq!(scene.camera.fov_degrees, 45.0);
+    assert_eq!(scene.camera.fov_axis, FovAxis::Y);
+    let origin = scene.camera.to_world.transform_point3(DVec3::ZERO);
+    assert!((origin - DVec3::new(0.0, 1.0, 5.0)).length() < 1e-12);
+    let forward = scene.camera.to_world.transform_vector3(DVec3::Z);
+    assert!((forward - DVec3::new(0.0, -1.0, -5.0).normalize()).length() < 1e-12);
+    assert_eq!(scene.shapes.len(), 7);
+    match &scene.shapes[0].geometry {
+        ShapeGeometry::Mesh { path, .. } => assert_eq!(path, Path::new("/scenes/meshes/bunny.obj")),
+        other => panic!("{other:?}"),
+    }
+    assert!(scene.shapes[0].face_normals);
+    assert_eq!(scene.shapes[0].bsdf, Some(0));
+    assert_eq!(scene.bsdfs[0].kind, "diffuse");
+    assert_eq!(
+        scene.bsdfs[0].properties["reflectance"].value,
+        Property::Rgb([0.5, 0.5, 0.5])
+    );
+    assert_eq!(
+        scene.shapes[1].geometry,
+        ShapeGeometry::Sphere {
+            center: DVec3::new(1.0, 2.0, 3.0),
+            radius: 0.5
+        }
+    );
+    assert_eq!(scene.shapes[1].emitter.as_ref().unwrap().kind, "area");
+    // Transforms compose in order: scale, then rotate, then translate.
+    let expected = DMat4::from_translation(DVec3::X)
+        * DMat4::from_axis_angle(DVec3::X, 90f64.to_radians())
+        * DMat4::from_scale(DVec3::splat(2.0));
+    assert!(scene.shapes[2].to_world.abs_diff_eq(expected, 1e-12));
+    assert!(scene.shapes[2].flip_normals);
+    assert_eq!(
+        scene.bsdfs[scene.shapes[2].bsdf.unwrap()].kind,
+        "roughconductor"
+    );
+    assert_eq!(scene.emitters.len(), 1);
+    assert_eq!(scene.emitters[0].kind, "envmap");
+    assert_eq!(scene.integrator.as_ref().unwrap().kind, "direct");
+    assert!(scene.warnings.is_empty(), "{:?}", scene.warnings);
+}
+
+#[test]
+fn command_line_parameters_override_defaults() {
+    let scene = parse_scene(Path::new("t.xml"), FULL, &[("spp".into(), "8".into())]).unwrap();
+    assert_eq!(scene.sample_count, 8);
+}
+
+#[test]
+fn matrix_transform_is_row_major() {
+    let scene = parse(
+        r#"<scene version="3.0.0"><shape type="cube"><transform name="to_world">
+        <matrix value="1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1"/></transform></shape></scene>"#,
+    )
+    .unwrap();
+    let p = scene.shapes[0].to_world.transform_point3(DVec3::ZERO);
+    assert_eq!(p, DVec3::new(5.0, 6.0, 7.0));
+}
+
+#[test]
+fn ignored_properties_and_filters_are_warned_about() {
+    let scene = parse(
+        r#"<scene version="3.0.0">
+        <sensor type="perspective"><float name="shutter" value="1"/>
+          <film type="hdrfilm"><rfilter type="gaussian"/></film></sensor>
+        <shape type="cube"><float name="weird" value="1"/></shape>
+        </scene>"#,
+    )
+    .unwrap();
+    let all = scene.warnings.join("\n");
+    assert!(all.contains("test.xml:2: property \"shutter\""), "{all}");
+    assert!(all.contains("gaussian"), "{all}");
+    assert!(all.contains("test.xml:4: property \"weird\""), "{all}");
+}
+
+#[test]
+fn every_error_names_file_line_and_problem() {
+    let cases: &[(&str, &str)] = &[
+        ("<scene><shape type=\"cube\"></scene>", "malformed XML"),
+        ("<world/>", "root element must be <scene>"),
+        ("<scene>\n<medium type=\"homogeneous\"/></scene>", "test.xml:2: <medium> is not supported"),
+        ("<scene>\n<include filename=\"x.xml\"/></scene>", "<include> is not supported"),
+        ("<scene>\n<banana/></scene>", "test.xml:2: unexpected element <banana> in <scene>"),
+        ("<scene>\n<shape/></scene>", "test.xml:2: <shape> needs a \"type\" attribute"),
+        ("<scene>\n<shape type=\"teapot\"/></scene>", "test.xml:2: shape type \"teapot\" is not supported"),
+        ("<scene>\n<shape type=\"obj\"/></scene>", "needs a \"filename\" string"),
+        ("<scene><shape type=\"sphere\">\n<float name=\"radius\" value=\"abc\"/></shape></scene>", "test.xml:2: \"abc\" is not a number"),
+        ("<scene><shape type=\"sphere\">\n<float name=\"radius\" value=\"-1\"/></shape></scene>", "radius must be positive"),
+        ("<scene><shape type=\"sphere\">\n<string name=\"radius\" value=\"1\"/></shape></scene>", "test.xml:2: property \"radius\" of shape \"sphere\" must be a float, not a string"),
+        ("<scene><shape type=\"cube\">\n<boolean name=\"flip_normals\" value=\"yes\"/></shape></scene>", "\"yes\" is not true or false"),
+        ("<scene><sensor type=\"perspective\"><film type=\"hdrfilm\">\n<integer name=\"width\" value=\"1.5\"/></film></sensor></scene>", "test.xml:2: \"1.5\" is not an integer"),
+        ("<scene><sensor type=\"perspective\"><film type=\"hdrfilm\">\n<integer name=\"width\" value=\"0\"/></film></sensor></scene>", "out of range"),
+        ("<scene><sensor type=\"orthographic\"/></scene>", "sensor type \"orthographic\" is not supported"),
+        ("<scene><sensor type=\"perspective\"><float name=\"fov\" value=\"200\"/></sensor></scene>", "fov must be in (0, 180)"),
+        ("<scene><sensor type=\"perspective\"><string name=\"fov_axis\" value=\"z\"/></sensor></scene>", "unknown fov_axis"),
+        ("<scene><sensor type=\"perspective\"><film type=\"ldrfilm\"/></sensor></scene>", "film type \"ldrfilm\" is not supported"),
+        ("<scene><sensor type=\"perspective\"><sampler type=\"independent\"><integer name=\"sample_count\" value=\"0\"/></sampler></sensor></scene>", "sample_count must be at least 1"),
+        ("<scene><sensor type=\"perspective\"/><sensor type=\"perspective\"/></scene>", "only one <sensor>"),
+        ("<scene><shape type=\"cube\">\n<ref id=\"nothing\"/></shape></scene>", "test.xml:2: no <bsdf> with id \"nothing\""),
+        ("<scene>\n<emitter type=\"area\"/></scene>", "test.xml:2: an area emitter must be nested in a <shape>"),
+        ("<scene><shape type=\"cube\">\n<emitter type=\"envmap\"/></shape></scene>", "can only carry an area emitter"),
+        ("<scene><shape type=\"cube\"><float name=\"x\" value=\"$missing\"/></shape></scene>", "parameter $missing has no <default>"),
+        ("<scene><shape type=\"cube\"><transform name=\"to_world\"><scale value=\"0\"/></transform></shape></scene>", "singular"),
+        ("<scene><shape type=\"cube\"><transform name=\"to_world\"><rotate angle=\"30\" x=\"0\"/></transform></shape></scene>", "non-zero axis"),
+        ("<scene><shape type=\"cube\"><transform name=\"to_world\"><matrix value=\"1 2 3\"/></transform></shape></scene>", "9 or 16 numbers"),
+        ("<scene><shape type=\"cube\"><transform name=\"to_world\"><lookat origin=\"0,0,0\" target=\"0,0,0\"/></transform></shape></scene>", "target = origin"),
+        ("<scene><shape type=\"cube\"><transform name=\"to_world\"><shear/></transform></shape></scene>", "unexpected element <shear> in <transform>"),
+        ("<scene><shape type=\"cube\"><rgb name=\"c\" value=\"1 2\"/></shape></scene>", "<rgb> needs 1 or 3 numbers"),
+        ("<scene><shape type=\"cube\"><point name=\"c\"/></shape></scene>", "<point> needs x, y, z or value"),
+        ("<scene><shape type=\"cube\"><default name=\"a\" value=\"1\"/></shape></scene>", "<default> must be a direct child"),
+        ("<scene><ref id=\"x\"/></scene>", "a <ref> at scene level"),
+    ];
+    for (text, expected) in cases {
+        let message = error(text);
+        assert!(
+            message.contains(expected),
+            "for {text}\n got: {message}\n want: {expected}"
+        );
+        assert!(
+            message.starts_with("/scenes/test.xml:"),
+            "no line in: {message}"
+        );
+    }
+}
