@@ -149,13 +149,15 @@ fn offset_rays_do_not_hit_the_surface_they_leave() {
         center: Vec3::new(100.0, -50.0, 30.0),
         radius: 20.0,
     };
-    let mut mesh = TriangleMesh::default();
-    mesh.positions = vec![
-        Vec3::new(500.0, 500.0, 500.0),
-        Vec3::new(530.0, 480.0, 510.0),
-        Vec3::new(505.0, 530.0, 470.0),
-    ];
-    mesh.triangles = vec![[0, 1, 2]];
+    let mesh = TriangleMesh {
+        positions: vec![
+            Vec3::new(500.0, 500.0, 500.0),
+            Vec3::new(530.0, 480.0, 510.0),
+            Vec3::new(505.0, 530.0, 470.0),
+        ],
+        normals: None,
+        triangles: vec![[0, 1, 2]],
+    };
     let geometry = Geometry::build(vec![
         ShapeInput {
             geometry: ShapeGeometry::Sphere(sphere),
