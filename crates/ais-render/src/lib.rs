@@ -6,6 +6,7 @@
 //! so images do not depend on the thread count.
 
 pub mod atomic_write;
+pub mod benchmark;
 pub mod camera;
 pub mod default_scene;
 pub mod error;
