@@ -1,8 +1,10 @@
 //! The `ais` command.
 
 use ais_render::default_scene::default_world;
+use ais_render::image_io::RgbImage;
 use ais_render::image_io::{write_exr, write_png};
-use ais_render::integrator::Integrator;
+use ais_render::integrator::{AisMode, GatherSettings, Integrator};
+use ais_render::proposal::Strategy;
 use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
@@ -67,8 +69,10 @@ fn run_bench(args: BenchArgs) -> Result<(), String> {
     Ok(())
 }
 
-#[derive(Clone, Copy, ValueEnum)]
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 enum IntegratorChoice {
+    /// Direct light gathered with `--rays` rays per camera sample through the AIS driver.
+    Gather,
     /// Ambient occlusion (cosine-weighted, bounded distance).
     Ao,
     /// Shading normals as colours.
@@ -91,9 +95,27 @@ struct RenderArgs {
     /// Override the film size, e.g. 640x360.
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,
-    /// What to render until the lighting integrators land.
-    #[arg(long, value_enum, default_value = "ao")]
-    integrator: IntegratorChoice,
+    /// What to render (default: the scene's <integrator type="gather">, else gather).
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorChoice>,
+    /// Gather proposal: uniform, bsdf, light or mis.
+    #[arg(long)]
+    strategy: Option<String>,
+    /// AIS mode: off, aggressive or conservative.
+    #[arg(long)]
+    ais: Option<String>,
+    /// Rays per gather (n).
+    #[arg(long)]
+    rays: Option<u32>,
+    /// Affinity-map tol (a_min = 1/(tol·h²)); "inf" for no floor.
+    #[arg(long)]
+    tol: Option<f32>,
+    /// Affinity-map height in texels (width is twice this).
+    #[arg(long)]
+    map_res: Option<u32>,
+    /// Also write the mean traced gather rays per camera sample, per pixel, to this EXR.
+    #[arg(long)]
+    aov_traced: Option<PathBuf>,
     /// Ambient-occlusion rays per camera sample.
     #[arg(long, default_value_t = 16)]
     ao_rays: u32,
@@ -116,6 +138,55 @@ struct RenderArgs {
     /// Set a scene $parameter: -D name=value (repeatable).
     #[arg(short = 'D', value_parser = parse_define)]
     define: Vec<(String, String)>,
+}
+
+/// Gather settings: defaults, then the scene's `<integrator type="gather">` properties,
+/// then command-line flags.
+fn gather_settings(
+    args: &RenderArgs,
+    plugin: Option<&ais_render::scene::Plugin>,
+) -> Result<GatherSettings, String> {
+    let mut settings = GatherSettings::default();
+    let mut strategy = None;
+    let mut ais = None;
+    if let Some(plugin) = plugin.filter(|p| p.kind == "gather") {
+        let at = |(line, message): (u32, String)| format!("line {line}: {message}");
+        strategy = plugin.string("strategy").map_err(at)?.map(str::to_string);
+        ais = plugin.string("ais").map_err(at)?.map(str::to_string);
+        settings.rays = plugin
+            .integer("rays", settings.rays as i64)
+            .map_err(at)?
+            .clamp(0, u32::MAX as i64) as u32;
+        settings.tol = plugin.float("tol", settings.tol as f64).map_err(at)? as f32;
+        settings.map_height = plugin
+            .integer("map_res", settings.map_height as i64)
+            .map_err(at)?
+            .clamp(0, 4096) as u32;
+    }
+    strategy = args.strategy.clone().or(strategy);
+    ais = args.ais.clone().or(ais);
+    if let Some(name) = strategy {
+        settings.strategy = Strategy::parse(&name)
+            .ok_or_else(|| format!("unknown strategy \"{name}\" (uniform, bsdf, light, mis)"))?;
+    }
+    if let Some(name) = ais {
+        settings.ais = AisMode::parse(&name).ok_or_else(|| {
+            format!("unknown AIS mode \"{name}\" (off, aggressive, conservative)")
+        })?;
+    }
+    settings.rays = args.rays.unwrap_or(settings.rays);
+    settings.tol = args.tol.unwrap_or(settings.tol);
+    settings.map_height = args.map_res.unwrap_or(settings.map_height);
+    if settings.rays == 0 {
+        return Err("the gather needs at least one ray (--rays)".into());
+    }
+    if settings.tol.is_nan() || settings.tol <= 0.0 {
+        return Err("--tol must be positive (or inf)".into());
+    }
+    if settings.map_height == 0 {
+        return Err("--map-res must be at least 1".into());
+    }
+    Ok(settings)
 }
 
 fn parse_resolution(text: &str) -> Result<(u32, u32), String> {
@@ -175,7 +246,33 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     for warning in &world.warnings {
         eprintln!("warning: {warning}");
     }
-    let integrator = match args.integrator {
+    let scene_integrator = world.description.integrator.clone();
+    let choice = match (args.integrator, &scene_integrator) {
+        (Some(choice), _) => choice,
+        (None, Some(plugin)) if plugin.kind == "gather" => IntegratorChoice::Gather,
+        (None, Some(plugin)) if plugin.kind == "direct" || plugin.kind == "path" => {
+            eprintln!(
+                "warning: {}:{}: integrator \"{}\" rendered with ais's gather (MIS, direct light only)",
+                world.description.file.display(),
+                plugin.line,
+                plugin.kind
+            );
+            IntegratorChoice::Gather
+        }
+        (None, Some(plugin)) => {
+            return Err(format!(
+                "{}:{}: integrator \"{}\" is not supported (gather, direct)",
+                world.description.file.display(),
+                plugin.line,
+                plugin.kind
+            ))
+        }
+        (None, None) => IntegratorChoice::Gather,
+    };
+    let integrator = match choice {
+        IntegratorChoice::Gather => {
+            Integrator::Gather(gather_settings(&args, scene_integrator.as_ref())?)
+        }
         IntegratorChoice::Normals => Integrator::Normals,
         IntegratorChoice::Ao => {
             if args.ao_rays == 0 || args.ao_distance.is_nan() || args.ao_distance <= 0.0 {
@@ -199,6 +296,15 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     };
     let output = render(&world, &settings);
     write_exr(&args.output, &output.image).map_err(|e| e.to_string())?;
+    if let Some(path) = &args.aov_traced {
+        let (width, height) = world.resolution;
+        let aov = RgbImage {
+            width: width as usize,
+            height: height as usize,
+            pixels: output.traced_per_sample.iter().map(|&t| [t; 3]).collect(),
+        };
+        write_exr(path, &aov).map_err(|e| e.to_string())?;
+    }
     let preview = args.output.with_extension("png");
     if !args.no_preview {
         write_png(&preview, &output.image, args.exposure).map_err(|e| e.to_string())?;
@@ -226,6 +332,25 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
         output.rays.occlusion,
         output.rays.total() as f64 / seconds.max(1e-9) / 1e6
     );
+    if let Integrator::Gather(settings) = integrator {
+        let stats = output.ais;
+        let gathers = stats.batches.max(1) as f64;
+        println!(
+            "gather       {} strategy, AIS {:?}, n = {}",
+            settings.strategy.name(),
+            settings.ais,
+            settings.rays
+        );
+        println!(
+            "candidates   {} ({:.1} per gather): traced {:.1}, rejected outside support {:.1}, by roulette {:.1} per gather; {} resets",
+            stats.candidates,
+            stats.candidates as f64 / gathers,
+            stats.traced as f64 / gathers,
+            stats.rejected_outside_support as f64 / gathers,
+            stats.rejected_roulette as f64 / gathers,
+            stats.resets
+        );
+    }
     println!("wrote        {}", args.output.display());
     if !args.no_preview {
         println!("preview      {}", preview.display());

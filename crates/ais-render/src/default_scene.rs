@@ -1,12 +1,17 @@
-//! The built-in default scene, made in code so that `ais render` needs no files: a grooved
-//! sculpture of several hundred thousand triangles on a ground plane. Its deep, narrow
-//! grooves occlude most directions from points inside them, the case AIS is for.
+//! The built-in default scene, made in code so that `ais render` needs no files: the talk's
+//! setup. A grooved sculpture of several hundred thousand triangles on a ground plane, lit by
+//! an HDRI-like procedural sky with a sun, two sphere lights and one rectangle light. The
+//! deep, narrow grooves occlude most directions from points inside them, the case AIS is for.
 
+use crate::bsdf::Material;
 use crate::camera::Camera;
-use crate::geometry::{Geometry, ShapeGeometry, ShapeInput};
+use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Sphere};
+use crate::image_io::RgbImage;
+use crate::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights};
 use crate::mesh::TriangleMesh;
 use crate::scene::{look_at, CameraDescription, FovAxis, SceneDescription};
 use crate::shapes;
+use crate::world::emitting_triangles;
 use crate::world::World;
 use glam::{DMat4, DVec3, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -84,6 +89,35 @@ pub fn default_camera() -> CameraDescription {
     }
 }
 
+/// A procedural lat-long sky (Mitsuba orientation, +y up): a horizon-bright blue gradient,
+/// a dim ground below the horizon, and a small, very bright sun.
+pub fn procedural_sky(width: usize, height: usize) -> RgbImage {
+    let sun = Vec3::new(0.55, 0.62, 0.56).normalize();
+    let sun_cos = (1.5f32).to_radians().cos();
+    let mut image = RgbImage::new(width, height);
+    for row in 0..height {
+        let theta = PI * (row as f32 + 0.5) / height as f32;
+        for column in 0..width {
+            let phi = TAU * (column as f32 + 0.5) / width as f32;
+            let d = Vec3::new(
+                phi.sin() * theta.sin(),
+                theta.cos(),
+                -phi.cos() * theta.sin(),
+            );
+            let value = if d.dot(sun) >= sun_cos {
+                Vec3::new(900.0, 820.0, 700.0)
+            } else if d.y >= 0.0 {
+                let horizon = (1.0 - d.y).powi(3);
+                Vec3::new(0.35, 0.55, 1.0) * (0.6 + 0.8 * horizon)
+            } else {
+                Vec3::new(0.18, 0.16, 0.14)
+            };
+            image.pixels[row * width + column] = value.to_array();
+        }
+    }
+    image
+}
+
 /// The built-in default scene at `width × height` pixels.
 pub fn default_world(width: u32, height: u32) -> World {
     let sculpture =
@@ -94,7 +128,28 @@ pub fn default_world(width: u32, height: u32) -> World {
         * DMat4::from_rotation_x(-std::f64::consts::FRAC_PI_2)
         * DMat4::from_scale(DVec3::splat(8.0));
     let ground = shapes::rectangle().transformed(ground_transform, false, false);
-    let geometry = Geometry::build(vec![
+    // The rectangle light: 0.7 × 0.7, facing the sculpture.
+    let panel_transform = look_at(
+        DVec3::new(-1.6, 1.9, 1.5),
+        DVec3::new(0.0, 0.2, 0.0),
+        DVec3::Y,
+    )
+    .expect("valid look-at")
+        * DMat4::from_scale(DVec3::splat(0.35));
+    let panel = shapes::rectangle().transformed(panel_transform, false, false);
+    let spheres = [
+        (
+            Vec3::new(1.55, 0.55, 1.25),
+            0.14,
+            Vec3::new(30.0, 20.0, 10.0),
+        ),
+        (
+            Vec3::new(-1.45, 0.1, -1.1),
+            0.18,
+            Vec3::new(8.0, 12.0, 25.0),
+        ),
+    ];
+    let mut inputs = vec![
         ShapeInput {
             geometry: ShapeGeometry::Mesh(sculpture),
             flip_normals: false,
@@ -103,7 +158,51 @@ pub fn default_world(width: u32, height: u32) -> World {
             geometry: ShapeGeometry::Mesh(ground),
             flip_normals: false,
         },
-    ]);
+        ShapeInput {
+            geometry: ShapeGeometry::Mesh(panel.clone()),
+            flip_normals: false,
+        },
+    ];
+    let mut area = vec![AreaLight::from_triangles(
+        emitting_triangles(&panel, false),
+        Vec3::new(12.0, 12.0, 11.0),
+        2,
+    )];
+    for (index, (center, radius, radiance)) in spheres.into_iter().enumerate() {
+        let sphere = Sphere { center, radius };
+        inputs.push(ShapeInput {
+            geometry: ShapeGeometry::Sphere(sphere),
+            flip_normals: false,
+        });
+        area.push(AreaLight {
+            shape: AreaShape::Sphere {
+                sphere,
+                flipped: false,
+            },
+            radiance,
+            shape_index: 3 + index as u32,
+        });
+    }
+    let geometry = Geometry::build(inputs);
+    let environment = Environment::Map(EnvironmentMap::new(
+        procedural_sky(512, 256),
+        glam::DMat3::IDENTITY,
+    ));
+    let (_, scene_radius) = geometry.bounding_sphere();
+    let lights = Lights::new(Some(environment), area, 5, scene_radius as f64);
+    let materials = vec![
+        Material {
+            reflectance: Vec3::splat(0.7),
+            two_sided: false,
+        },
+        Material {
+            reflectance: Vec3::new(0.45, 0.42, 0.38),
+            two_sided: false,
+        },
+        Material::default(),
+        Material::default(),
+        Material::default(),
+    ];
     let camera_description = default_camera();
     let description = SceneDescription {
         file: "<built-in default scene>".into(),
@@ -118,6 +217,8 @@ pub fn default_world(width: u32, height: u32) -> World {
     };
     World {
         geometry,
+        lights,
+        materials,
         camera: Camera::new(&camera_description, width, height),
         resolution: (width, height),
         sample_count: 4,

@@ -1,9 +1,13 @@
 //! Integrators available before lighting lands: shading normals and ambient occlusion.
 //! They exist to verify geometry; the AIS gather integrator comes with the lighting issue.
 
+use crate::bsdf::ShadingFrame;
 use crate::geometry::{spawn_ray, Ray};
+use crate::lights::luminance;
+use crate::proposal::{GatherPoint, Strategy};
 use crate::world::World;
 use ais::rng::Pcg32;
+use ais::{rating, Batch, BatchConfig, Decision, MapConfig, MapStart, Mode, Stopping};
 use glam::Vec3;
 
 /// Rays traced, by kind.
@@ -28,9 +32,103 @@ impl RayCounts {
     }
 }
 
+/// AIS setting of the gather.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum AisMode {
+    /// No affinity map: every in-support candidate is traced.
+    Off,
+    /// The talk's aggressive map.
+    Aggressive,
+    /// The talk's conservative map (shadow-edge resets).
+    Conservative,
+}
+
+impl AisMode {
+    /// Parses a command-line or XML name.
+    pub fn parse(name: &str) -> Option<AisMode> {
+        match name {
+            "off" => Some(AisMode::Off),
+            "aggressive" => Some(AisMode::Aggressive),
+            "conservative" => Some(AisMode::Conservative),
+            _ => None,
+        }
+    }
+}
+
+/// Settings of the multi-ray gather integrator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GatherSettings {
+    /// The proposal sampler.
+    pub strategy: Strategy,
+    /// AIS off, aggressive or conservative.
+    pub ais: AisMode,
+    /// Rays per gather (n).
+    pub rays: u32,
+    /// The map's tol (a_min = 1 / (tol h²)).
+    pub tol: f32,
+    /// The map's height in texels.
+    pub map_height: u32,
+}
+
+impl Default for GatherSettings {
+    fn default() -> Self {
+        let map = MapConfig::default();
+        GatherSettings {
+            strategy: Strategy::Mis,
+            ais: AisMode::Aggressive,
+            rays: 64,
+            tol: map.tol,
+            map_height: map.height,
+        }
+    }
+}
+
+impl GatherSettings {
+    /// The batch configuration. Every mode uses the candidate-budget stopping rule, which is
+    /// exactly unbiased with Halton placement even when candidates fall outside the support.
+    pub fn batch_config(&self) -> BatchConfig {
+        let base = BatchConfig {
+            stopping: Stopping::CandidateBudget,
+            ..BatchConfig::default()
+        };
+        match self.ais {
+            AisMode::Off => BatchConfig {
+                affinity: None,
+                learning: ais::Learning::Off,
+                ..base
+            },
+            AisMode::Aggressive | AisMode::Conservative => BatchConfig {
+                affinity: Some(MapConfig {
+                    height: self.map_height,
+                    tol: self.tol,
+                    mode: if self.ais == AisMode::Aggressive {
+                        Mode::Aggressive
+                    } else {
+                        Mode::Conservative
+                    },
+                    ..MapConfig::default()
+                }),
+                ..base
+            },
+        }
+    }
+}
+
+/// Per-thread state of a render: counters and the reusable AIS batch.
+#[derive(Default)]
+pub struct SampleContext {
+    /// Rays traced.
+    pub counts: RayCounts,
+    /// The gather's batch driver (allocated on first use).
+    pub batch: Option<Batch<[f32; 3]>>,
+}
+
 /// What to compute at each camera sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Integrator {
+    /// Direct light gathered at the first hit with `rays` rays through the AIS batch
+    /// driver, plus emitters seen directly.
+    Gather(GatherSettings),
     /// Shading normal mapped to colour, (n + 1) / 2; black on a miss.
     Normals,
     /// Ambient occlusion by `rays` cosine-weighted hemisphere rays of length `distance`
@@ -61,11 +159,16 @@ impl Integrator {
         world: &World,
         ray: &Ray,
         rng: &mut Pcg32,
-        counts: &mut RayCounts,
+        context: &mut SampleContext,
     ) -> [f32; 3] {
+        if let Integrator::Gather(settings) = self {
+            return gather(world, settings, ray, rng, context).to_array();
+        }
+        let counts = &mut context.counts;
         counts.closest_hit += 1;
         let hit = world.geometry.intersect(ray);
         match (self, hit) {
+            (Integrator::Gather(_), _) => unreachable!("handled above"),
             (Integrator::Normals, None) => [0.0; 3],
             (Integrator::Normals, Some(hit)) => (hit.shading_normal * 0.5 + 0.5).to_array(),
             (Integrator::AmbientOcclusion { .. }, None) => [1.0; 3],
@@ -100,6 +203,76 @@ impl Integrator {
             }
         }
     }
+}
+
+/// The gather: emitted radiance at the first hit plus `n` rays of direct light through the
+/// AIS batch driver.
+fn gather(
+    world: &World,
+    settings: &GatherSettings,
+    ray: &Ray,
+    rng: &mut Pcg32,
+    context: &mut SampleContext,
+) -> Vec3 {
+    context.counts.closest_hit += 1;
+    let Some(hit) = world.geometry.intersect(ray) else {
+        return world.lights.background(ray.direction);
+    };
+    let emitted = world
+        .lights
+        .emitted(hit.shape, hit.geometric_normal, ray.direction);
+    if world.lights.is_empty() {
+        return emitted;
+    }
+    let wo = -ray.direction;
+    let material = &world.materials[hit.shape as usize];
+    let frame = ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo);
+    let at = GatherPoint {
+        point: hit.point,
+        frame,
+        wo,
+        material,
+        lights: &world.lights,
+    };
+    let batch = context.batch.get_or_insert_with(|| {
+        Batch::new(settings.batch_config()).expect("valid gather configuration")
+    });
+    let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+    batch.begin(settings.rays, seed, MapStart::Empty);
+    while let Some(candidate) = batch.next_candidate() {
+        let Some((direction, pdf)) = settings
+            .strategy
+            .sample(&at, candidate.u)
+            .filter(|s| s.1 > 0.0)
+        else {
+            batch.decide(frame.normal, false);
+            continue;
+        };
+        let in_support = material.in_support(&frame, wo, direction);
+        if let Decision::Trace { .. } = batch.decide(direction, in_support) {
+            let mut leaving = spawn_ray(hit.point, frame.geometric, direction);
+            let (unoccluded, distance) = world.lights.unoccluded(&leaving);
+            // The emitter's own surface is in the BVH: stop just short of it. A ray whose
+            // unoccluded radiance is zero brings zero whatever blocks it: no need to trace.
+            let actual = if unoccluded == Vec3::ZERO {
+                Vec3::ZERO
+            } else {
+                leaving.t_max = distance * (1.0 - 1e-4);
+                context.counts.occlusion += 1;
+                if world.geometry.occluded(&leaving) {
+                    Vec3::ZERO
+                } else {
+                    unoccluded
+                }
+            };
+            let value = material.eval(&frame, wo, direction) * actual / pdf as f32;
+            batch.record(
+                value.to_array(),
+                rating(luminance(actual), luminance(unoccluded)),
+            );
+        }
+    }
+    emitted + Vec3::from(batch.finish().value)
 }
 
 #[cfg(test)]

@@ -7,14 +7,18 @@
 
 pub mod atomic_write;
 pub mod benchmark;
+pub mod bsdf;
 pub mod camera;
 pub mod default_scene;
+pub mod distribution;
 pub mod error;
 pub mod film;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;
+pub mod lights;
 pub mod mesh;
+pub mod proposal;
 pub mod render;
 pub mod scene;
 pub mod shapes;

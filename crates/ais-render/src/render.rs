@@ -3,7 +3,7 @@
 
 use crate::film::Film;
 use crate::image_io::RgbImage;
-use crate::integrator::{Integrator, RayCounts};
+use crate::integrator::{Integrator, RayCounts, SampleContext};
 use crate::world::World;
 use ais::rng::{mix64, Pcg32};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -32,6 +32,10 @@ pub struct RenderOutput {
     pub image: RgbImage,
     /// Rays traced.
     pub rays: RayCounts,
+    /// Counts of the AIS batches (gather integrator only).
+    pub ais: ais::Stats,
+    /// Mean traced gather rays per camera sample, per pixel (an AOV).
+    pub traced_per_sample: Vec<f32>,
     /// Wall time of the render loop.
     pub time: Duration,
 }
@@ -64,14 +68,17 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
         ProgressBar::hidden()
     };
     let started = Instant::now();
-    let results: Vec<(usize, usize, Vec<[f32; 3]>, RayCounts)> = tiles
+    type TileResult = (usize, usize, Vec<[f32; 3]>, Vec<f32>, RayCounts, ais::Stats);
+    let results: Vec<TileResult> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
-            let mut counts = RayCounts::default();
+            let mut context = SampleContext::default();
             let mut pixels = Vec::with_capacity(TILE_SIZE * TILE_SIZE);
+            let mut traced = Vec::with_capacity(TILE_SIZE * TILE_SIZE);
             for y in y0..(y0 + TILE_SIZE).min(height) {
                 for x in x0..(x0 + TILE_SIZE).min(width) {
                     let mut rng = Pcg32::new(pixel_seed(settings.seed, x, y, width), 0);
+                    let traced_before = context.batch.as_ref().map_or(0, |b| b.stats().traced);
                     let mut sum = [0.0f64; 3];
                     for _ in 0..settings.samples_per_pixel {
                         let u = (x as f32 + rng.next_f32()) / width as f32;
@@ -80,31 +87,47 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
                         let value =
                             settings
                                 .integrator
-                                .radiance(world, &ray, &mut rng, &mut counts);
+                                .radiance(world, &ray, &mut rng, &mut context);
                         for (s, c) in sum.iter_mut().zip(value) {
                             *s += c as f64;
                         }
                     }
                     pixels.push(sum.map(|s| (s / settings.samples_per_pixel as f64) as f32));
+                    let traced_after = context.batch.as_ref().map_or(0, |b| b.stats().traced);
+                    traced.push(
+                        (traced_after - traced_before) as f32 / settings.samples_per_pixel as f32,
+                    );
                 }
             }
             progress.inc(1);
-            (x0, y0, pixels, counts)
+            let stats = context
+                .batch
+                .as_ref()
+                .map(|b| *b.stats())
+                .unwrap_or_default();
+            (x0, y0, pixels, traced, context.counts, stats)
         })
         .collect();
     progress.finish_and_clear();
     let mut film = Film::new(width, height);
     let mut rays = RayCounts::default();
-    for (x0, y0, pixels, counts) in results {
+    let mut ais_stats = ais::Stats::default();
+    let mut traced_per_sample = vec![0.0; width * height];
+    for (x0, y0, pixels, traced, counts, stats) in results {
         rays.merge(counts);
+        ais_stats.merge(&stats);
         let tile_width = (x0 + TILE_SIZE).min(width) - x0;
-        for (i, value) in pixels.into_iter().enumerate() {
-            film.add(x0 + i % tile_width, y0 + i / tile_width, value);
+        for (i, (value, traced)) in pixels.into_iter().zip(traced).enumerate() {
+            let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
+            film.add(x, y, value);
+            traced_per_sample[y * width + x] = traced;
         }
     }
     RenderOutput {
         image: film.image(),
         rays,
+        ais: ais_stats,
+        traced_per_sample,
         time: started.elapsed(),
     }
 }

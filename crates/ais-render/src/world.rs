@@ -1,11 +1,16 @@
 //! A scene ready to render: geometry in a BVH, the camera, and the settings.
 
+use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::error::InputError;
-use crate::geometry::{Geometry, ShapeGeometry, ShapeInput};
-use crate::mesh::{load_mesh, validate};
-use crate::scene::{self, SceneDescription};
+use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
+use crate::image_io::read_image;
+use crate::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights};
+use crate::mesh::{load_mesh, validate, TriangleMesh};
+use crate::scene::{self, Plugin, Property, SceneDescription};
 use crate::shapes;
+use glam::{DMat3, Vec3};
+use std::path::Path;
 
 /// Everything a render needs.
 pub struct World {
@@ -17,7 +22,11 @@ pub struct World {
     pub resolution: (u32, u32),
     /// Samples per pixel from the scene file.
     pub sample_count: u32,
-    /// The description it was built from (materials and emitters are carried here).
+    /// The emitters.
+    pub lights: Lights,
+    /// The material of each shape.
+    pub materials: Vec<Material>,
+    /// The description it was built from.
     pub description: SceneDescription,
     /// Warnings from reading the scene and its assets.
     pub warnings: Vec<String>,
@@ -29,17 +38,36 @@ impl World {
         let mut warnings = description.warnings.clone();
         let file = description.file.clone();
         let mut inputs = Vec::with_capacity(description.shapes.len());
-        for shape in &description.shapes {
+        let mut area_lights = Vec::new();
+        let mut materials = Vec::with_capacity(description.shapes.len());
+        for (shape_index, shape) in description.shapes.iter().enumerate() {
+            materials.push(match shape.bsdf {
+                Some(index) => {
+                    Material::from_plugin(&description.bsdfs[index], &file, &mut warnings)
+                }
+                None => Material::default(),
+            });
+            let radiance = shape
+                .emitter
+                .as_ref()
+                .map(|e| radiance_property(&file, e, "radiance"))
+                .transpose()?;
             let mesh = match &shape.geometry {
                 scene::ShapeGeometry::Sphere { center, radius } => {
+                    let geometry =
+                        shapes::sphere(&file, shape.line, *center, *radius, shape.to_world)?;
+                    if let (Some(radiance), ShapeGeometry::Sphere(sphere)) = (radiance, &geometry) {
+                        area_lights.push(AreaLight {
+                            shape: AreaShape::Sphere {
+                                sphere: *sphere,
+                                flipped: shape.flip_normals,
+                            },
+                            radiance,
+                            shape_index: shape_index as u32,
+                        });
+                    }
                     inputs.push(ShapeInput {
-                        geometry: shapes::sphere(
-                            &file,
-                            shape.line,
-                            *center,
-                            *radius,
-                            shape.to_world,
-                        )?,
+                        geometry,
                         flip_normals: shape.flip_normals,
                     });
                     continue;
@@ -63,20 +91,136 @@ impl World {
                 )
             })?;
             warnings.extend(checked.warnings);
+            if let Some(radiance) = radiance {
+                area_lights.push(AreaLight::from_triangles(
+                    emitting_triangles(&checked.mesh, shape.flip_normals),
+                    radiance,
+                    shape_index as u32,
+                ));
+            }
             inputs.push(ShapeInput {
                 geometry: ShapeGeometry::Mesh(checked.mesh),
                 flip_normals: shape.flip_normals,
             });
         }
         let geometry = Geometry::build(inputs);
+        let environment = match description.emitters.as_slice() {
+            [] => None,
+            [one] => Some(environment(&file, one, &mut warnings)?),
+            [_, second, ..] => {
+                return Err(InputError::at(
+                    &file,
+                    second.line,
+                    "only one scene-level emitter (envmap or constant) is supported",
+                ))
+            }
+        };
+        let (_, radius) = geometry.bounding_sphere();
+        let lights = Lights::new(
+            environment,
+            area_lights,
+            description.shapes.len(),
+            radius.max(1e-3) as f64,
+        );
         let (width, height) = description.resolution;
         Ok(World {
             geometry,
+            lights,
+            materials,
             camera: Camera::new(&description.camera, width, height),
             resolution: description.resolution,
             sample_count: description.sample_count,
             description,
             warnings,
         })
+    }
+}
+
+/// The triangles of a mesh as a light, wound toward the emitting side.
+pub fn emitting_triangles(mesh: &TriangleMesh, flip_normals: bool) -> Vec<Triangle> {
+    mesh.triangles
+        .iter()
+        .enumerate()
+        .map(|(index, &[a, b, c])| {
+            let (a, b, c) = if flip_normals { (a, c, b) } else { (a, b, c) };
+            Triangle {
+                vertices: [a, b, c].map(|i| mesh.positions[i as usize]),
+                mesh: 0,
+                index: index as u32,
+            }
+        })
+        .collect()
+}
+
+/// An rgb or float radiance property, which must be finite and non-negative.
+fn radiance_property(file: &Path, plugin: &Plugin, name: &str) -> Result<Vec3, InputError> {
+    let value = match plugin.properties.get(name).map(|p| &p.value) {
+        Some(Property::Rgb(c)) => Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32),
+        Some(Property::Float(v)) => Vec3::splat(*v as f32),
+        None => {
+            return Err(InputError::at(
+                file,
+                plugin.line,
+                format!("{} emitter needs \"{name}\"", plugin.kind),
+            ))
+        }
+        Some(other) => {
+            return Err(InputError::at(
+                file,
+                plugin.line,
+                format!("{name} must be an rgb or float, not a {}", other.kind()),
+            ))
+        }
+    };
+    if !value.is_finite() || value.min_element() < 0.0 {
+        return Err(InputError::at(
+            file,
+            plugin.line,
+            format!("{name} must be finite and non-negative"),
+        ));
+    }
+    Ok(value)
+}
+
+/// A scene-level `envmap` or `constant` emitter.
+fn environment(
+    file: &Path,
+    plugin: &Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<Environment, InputError> {
+    let at = |(line, message): (u32, String)| InputError::at(file, line, message);
+    match plugin.kind.as_str() {
+        "constant" => Ok(Environment::Constant(radiance_property(
+            file, plugin, "radiance",
+        )?)),
+        "envmap" => {
+            let name = plugin
+                .string("filename")
+                .map_err(at)?
+                .ok_or_else(|| InputError::at(file, plugin.line, "envmap needs a \"filename\""))?;
+            let path = file.parent().unwrap_or(Path::new(".")).join(name);
+            let loaded = read_image(&path)?;
+            warnings.extend(loaded.warning);
+            let scale = plugin.float("scale", 1.0).map_err(at)? as f32;
+            if !(scale.is_finite() && scale >= 0.0) {
+                return Err(InputError::at(
+                    file,
+                    plugin.line,
+                    "envmap scale must be finite and non-negative",
+                ));
+            }
+            let mut image = loaded.image;
+            for p in &mut image.pixels {
+                *p = p.map(|c| c * scale);
+            }
+            let to_world = plugin.transform("to_world").map_err(at)?;
+            let rotation = DMat3::from_mat4(to_world);
+            Ok(Environment::Map(EnvironmentMap::new(image, rotation)))
+        }
+        other => Err(InputError::at(
+            file,
+            plugin.line,
+            format!("emitter type \"{other}\" is not supported (envmap, constant, area)"),
+        )),
     }
 }

@@ -17,6 +17,7 @@
 //! - [`halton`]: the scrambled 3-D Halton sequence;
 //! - [`epochs`]: frozen-map epochs (the exactly unbiased learning schedule);
 //! - [`batch`]: the driver, the stopping rule and the estimator;
+//! - [`chi2`]: the chi-square goodness-of-fit test used to validate samplers;
 //! - [`stats`]: counters; [`value`]: what a batch can average; [`rng`]: a seedable PCG32;
 //! - [`analytic`]: analytic gather scenes with exact integrals, for tests, studies and hosts
 //!   that want to validate their integration.
@@ -24,6 +25,7 @@
 pub mod affinity_map;
 pub mod analytic;
 pub mod batch;
+pub mod chi2;
 pub mod epochs;
 pub mod halton;
 pub mod mapping;

@@ -144,6 +144,30 @@ impl Geometry {
         self.primitives.len()
     }
 
+    /// Centre and radius of a sphere enclosing every primitive (zero for an empty scene).
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        let mut low = Vec3::splat(f32::INFINITY);
+        let mut high = Vec3::splat(f32::NEG_INFINITY);
+        for primitive in &self.primitives {
+            match primitive {
+                Primitive::Triangle(t) => {
+                    for v in t.vertices {
+                        low = low.min(v);
+                        high = high.max(v);
+                    }
+                }
+                Primitive::Sphere(s) => {
+                    low = low.min(s.center - s.radius);
+                    high = high.max(s.center + s.radius);
+                }
+            }
+        }
+        if low.x > high.x {
+            return (Vec3::ZERO, 0.0);
+        }
+        ((low + high) * 0.5, (high - low).length() * 0.5)
+    }
+
     /// Wall time of [`Geometry::build`].
     pub fn build_time(&self) -> Duration {
         self.build_time

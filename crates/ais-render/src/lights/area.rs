@@ -1,0 +1,198 @@
+//! Area lights: spheres (sampled uniformly inside the subtended cone) and triangle meshes,
+//! including Mitsuba's rectangles (area-weighted triangle choice, uniform points on the
+//! triangle). Emission is one-sided, toward the surface normal, as in Mitsuba.
+
+use crate::distribution::Distribution1D;
+use crate::geometry::{Ray, Sphere, Triangle};
+use glam::Vec3;
+use std::f64::consts::PI;
+
+/// The emitting surface.
+#[derive(Clone, Debug)]
+pub enum AreaShape {
+    /// A sphere emitting outward (inward when its normals are flipped).
+    Sphere {
+        /// The sphere.
+        sphere: Sphere,
+        /// Whether the shape's normals are flipped.
+        flipped: bool,
+    },
+    /// Triangles, each emitting toward the side of its (possibly flipped) winding normal.
+    Triangles {
+        /// World-space triangles, already wound so that the emitting side is front.
+        triangles: Vec<Triangle>,
+        /// Area-proportional choice of a triangle.
+        choice: Distribution1D,
+        /// Total area.
+        area: f64,
+    },
+}
+
+/// A light sample: where it points and what it sends.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaSample {
+    /// Unit direction from the receiver toward the light.
+    pub direction: Vec3,
+    /// Density in solid angle at the receiver.
+    pub pdf: f64,
+}
+
+/// An area light.
+#[derive(Clone, Debug)]
+pub struct AreaLight {
+    /// The surface.
+    pub shape: AreaShape,
+    /// Emitted radiance (front side).
+    pub radiance: Vec3,
+    /// The geometry shape it belongs to.
+    pub shape_index: u32,
+}
+
+impl AreaLight {
+    /// Triangles (wound toward the emitting side) as a light.
+    pub fn from_triangles(triangles: Vec<Triangle>, radiance: Vec3, shape_index: u32) -> Self {
+        let areas: Vec<f64> = triangles
+            .iter()
+            .map(|t| 0.5 * t.normal().length() as f64)
+            .collect();
+        let area = areas.iter().sum();
+        AreaLight {
+            shape: AreaShape::Triangles {
+                choice: Distribution1D::new(&areas),
+                triangles,
+                area,
+            },
+            radiance,
+            shape_index,
+        }
+    }
+
+    /// Emitted power, π · luminance · area (one-sided Lambertian emitter).
+    pub fn power(&self) -> f64 {
+        let area = match &self.shape {
+            AreaShape::Sphere { sphere, .. } => 4.0 * PI * (sphere.radius as f64).powi(2),
+            AreaShape::Triangles { area, .. } => *area,
+        };
+        PI * super::luminance(self.radiance) as f64 * area
+    }
+
+    /// Radiance leaving the light toward `-direction` at a point with geometric normal
+    /// `normal` (front side only).
+    pub fn emitted(&self, normal: Vec3, direction: Vec3) -> Vec3 {
+        if normal.dot(direction) < 0.0 {
+            self.radiance
+        } else {
+            Vec3::ZERO
+        }
+    }
+
+    /// A direction toward the light from `point`.
+    pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<AreaSample> {
+        match &self.shape {
+            AreaShape::Sphere { sphere, .. } => {
+                let to_center = sphere.center - point;
+                let distance_squared = to_center.length_squared() as f64;
+                let r2 = (sphere.radius as f64).powi(2);
+                if distance_squared <= r2 {
+                    return None; // inside the sphere: no cone to sample
+                }
+                let cos_max = (1.0 - r2 / distance_squared).max(0.0).sqrt();
+                let cos_theta = 1.0 - u[0] as f64 * (1.0 - cos_max);
+                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+                let phi = 2.0 * PI * u[1] as f64;
+                let axis = to_center.normalize();
+                let (t, b) = crate::integrator::basis(axis);
+                let direction = (t * (sin_theta * phi.cos()) as f32
+                    + b * (sin_theta * phi.sin()) as f32
+                    + axis * cos_theta as f32)
+                    .normalize();
+                Some(AreaSample {
+                    direction,
+                    pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+                })
+            }
+            AreaShape::Triangles {
+                triangles,
+                choice,
+                area,
+            } => {
+                let (x, _, index) = choice.sample(u[0] as f64);
+                // The position within the chosen bin is a fresh uniform number.
+                let u0 = (x * choice.len() as f64 - index as f64).clamp(0.0, 1.0);
+                let triangle = &triangles[index];
+                let su = u0.sqrt();
+                let (b1, b2) = (1.0 - su, u[1] as f64 * su);
+                let [v0, v1, v2] = triangle.vertices;
+                let target = v0 * (1.0 - b1 - b2) as f32 + v1 * b1 as f32 + v2 * b2 as f32;
+                let offset = target - point;
+                let distance_squared = offset.length_squared() as f64;
+                if distance_squared == 0.0 {
+                    return None;
+                }
+                let direction = offset.normalize();
+                let normal = triangle.normal().normalize();
+                let cosine = normal.dot(direction).abs() as f64;
+                if cosine <= 0.0 {
+                    return None;
+                }
+                Some(AreaSample {
+                    direction,
+                    pdf: distance_squared / (cosine * area),
+                })
+            }
+        }
+    }
+
+    /// Density of [`AreaLight::sample`] at `direction` from `point`, in solid angle.
+    pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
+        match &self.shape {
+            AreaShape::Sphere { sphere, .. } => {
+                let to_center = sphere.center - point;
+                let distance_squared = to_center.length_squared() as f64;
+                let r2 = (sphere.radius as f64).powi(2);
+                if distance_squared <= r2 {
+                    return 0.0;
+                }
+                let cos_max = (1.0 - r2 / distance_squared).max(0.0).sqrt();
+                let cosine = to_center.normalize().dot(direction) as f64;
+                if cosine >= cos_max {
+                    1.0 / (2.0 * PI * (1.0 - cos_max))
+                } else {
+                    0.0
+                }
+            }
+            AreaShape::Triangles {
+                triangles, area, ..
+            } => {
+                // A direction may cross several triangles of a non-convex mesh: densities add.
+                let ray = Ray::new(point, direction);
+                triangles
+                    .iter()
+                    .filter_map(|triangle| {
+                        let (t, _) = triangle.intersect(&ray, f32::INFINITY)?;
+                        let cosine = triangle.normal().normalize().dot(direction).abs() as f64;
+                        (cosine > 0.0).then(|| (t as f64).powi(2) / (cosine * area))
+                    })
+                    .sum()
+            }
+        }
+    }
+
+    /// The nearest point of the light along a ray: distance and the geometric normal there.
+    pub fn intersect(&self, ray: &Ray) -> Option<(f32, Vec3)> {
+        match &self.shape {
+            AreaShape::Sphere { sphere, flipped } => {
+                let t = sphere.intersect(ray, ray.t_max)?;
+                let n = (ray.at(t) - sphere.center).normalize();
+                Some((t, if *flipped { -n } else { n }))
+            }
+            AreaShape::Triangles { triangles, .. } => triangles
+                .iter()
+                .filter_map(|tri| {
+                    tri.intersect(ray, ray.t_max)
+                        .map(|(t, _)| (t, tri.normal().normalize()))
+                })
+                .min_by(|a, b| a.0.total_cmp(&b.0)),
+        }
+    }
+}

@@ -1,0 +1,126 @@
+//! All emitters of a scene: an optional environment and area lights, chosen in proportion
+//! to their estimated power for light sampling.
+
+mod area;
+mod environment;
+
+pub use area::{AreaLight, AreaSample, AreaShape};
+pub use environment::{luminance, Environment, EnvironmentMap};
+
+use crate::distribution::Distribution1D;
+use crate::geometry::Ray;
+use glam::Vec3;
+use std::f64::consts::PI;
+
+/// The emitters of a scene.
+#[derive(Clone, Debug, Default)]
+pub struct Lights {
+    /// The environment, if any.
+    pub environment: Option<Environment>,
+    /// Area lights.
+    pub area: Vec<AreaLight>,
+    /// For each geometry shape, its area light (index into `area`).
+    pub shape_lights: Vec<Option<usize>>,
+    /// Choice of a light: index 0..area.len() for area lights, area.len() for the environment.
+    choice: Option<Distribution1D>,
+}
+
+impl Lights {
+    /// Lights with selection weights from their power; the environment's power is taken as
+    /// π · mean luminance · π R² for a scene of bounding radius `scene_radius`.
+    pub fn new(
+        environment: Option<Environment>,
+        area: Vec<AreaLight>,
+        shape_count: usize,
+        scene_radius: f64,
+    ) -> Self {
+        let mut shape_lights = vec![None; shape_count];
+        for (index, light) in area.iter().enumerate() {
+            shape_lights[light.shape_index as usize] = Some(index);
+        }
+        let mut weights: Vec<f64> = area.iter().map(AreaLight::power).collect();
+        if let Some(environment) = &environment {
+            weights.push(PI * environment.mean_luminance() * PI * scene_radius * scene_radius);
+        }
+        let choice = (!weights.is_empty()).then(|| Distribution1D::new(&weights));
+        Lights {
+            environment,
+            area,
+            shape_lights,
+            choice,
+        }
+    }
+
+    /// Whether the scene has no emitter at all.
+    pub fn is_empty(&self) -> bool {
+        self.choice.is_none()
+    }
+
+    /// Probability of choosing light `index` (area lights first, then the environment).
+    fn choice_probability(&self, index: usize) -> f64 {
+        self.choice
+            .as_ref()
+            .map_or(0.0, |c| c.bin_probability(index))
+    }
+
+    /// A direction from `point` drawn by light sampling, with the density of the whole
+    /// light-sampling strategy at that direction (all lights that could produce it).
+    pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
+        let choice = self.choice.as_ref()?;
+        let (x, _, index) = choice.sample(u[0] as f64);
+        let u0 = ((x * choice.len() as f64 - index as f64).clamp(0.0, 1.0 - 1e-7)) as f32;
+        let direction = if index < self.area.len() {
+            self.area[index].sample(point, [u0, u[1]])?.direction
+        } else {
+            self.environment.as_ref()?.sample([u0, u[1]]).0
+        };
+        let pdf = self.pdf(point, direction);
+        (pdf > 0.0).then_some((direction, pdf))
+    }
+
+    /// Density of light sampling at `direction` from `point`, in solid angle.
+    pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
+        let mut pdf = 0.0;
+        for (index, light) in self.area.iter().enumerate() {
+            let p = self.choice_probability(index);
+            if p > 0.0 {
+                pdf += p * light.pdf(point, direction);
+            }
+        }
+        if let Some(environment) = &self.environment {
+            pdf += self.choice_probability(self.area.len()) * environment.pdf(direction);
+        }
+        pdf
+    }
+
+    /// Radiance arriving along the ray from the first emitter, ignoring every occluder that
+    /// is not an emitter, and the distance to that emitter (infinite for the environment):
+    /// what the ray would bring if nothing blocked it, and how far it must be free.
+    pub fn unoccluded(&self, ray: &Ray) -> (Vec3, f32) {
+        let nearest = self
+            .area
+            .iter()
+            .filter_map(|light| light.intersect(ray).map(|(t, n)| (t, n, light)))
+            .min_by(|a, b| a.0.total_cmp(&b.0));
+        match nearest {
+            Some((t, normal, light)) => (light.emitted(normal, ray.direction), t),
+            None => (self.background(ray.direction), f32::INFINITY),
+        }
+    }
+
+    /// Radiance of the environment in `direction` (black without one).
+    pub fn background(&self, direction: Vec3) -> Vec3 {
+        self.environment
+            .as_ref()
+            .map_or(Vec3::ZERO, |e| e.radiance(direction))
+    }
+
+    /// Radiance emitted toward `-direction` by shape `shape` at a point with geometric
+    /// normal `normal` (zero if the shape is not an emitter).
+    pub fn emitted(&self, shape: u32, normal: Vec3, direction: Vec3) -> Vec3 {
+        match self.shape_lights.get(shape as usize).copied().flatten() {
+            Some(index) => self.area[index].emitted(normal, direction),
+            None => Vec3::ZERO,
+        }
+    }
+}

@@ -1,0 +1,113 @@
+//! Proposal samplers for the gather: uniform, BSDF, light, and their MIS mixture. Each gives
+//! a direction and the density of the whole strategy at that direction.
+
+use crate::bsdf::{Material, ShadingFrame};
+use crate::lights::Lights;
+use glam::Vec3;
+use std::f64::consts::PI;
+
+/// Which distribution proposes the gather's candidate directions.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strategy {
+    /// Uniform over the sphere (half the candidates are outside a reflective BSDF's support).
+    Uniform,
+    /// BSDF sampling (cosine-weighted for diffuse).
+    Bsdf,
+    /// Light sampling: a light chosen in proportion to its power, then a direction toward it.
+    Light,
+    /// One-sample MIS with the balance heuristic, i.e. the 50/50 mixture of BSDF and light
+    /// sampling, weighted by the mixture density.
+    Mis,
+}
+
+impl Strategy {
+    /// Parses a command-line or XML name.
+    pub fn parse(name: &str) -> Option<Strategy> {
+        match name {
+            "uniform" => Some(Strategy::Uniform),
+            "bsdf" => Some(Strategy::Bsdf),
+            "light" | "emitter" => Some(Strategy::Light),
+            "mis" => Some(Strategy::Mis),
+            _ => None,
+        }
+    }
+
+    /// The name [`Strategy::parse`] accepts.
+    pub fn name(self) -> &'static str {
+        match self {
+            Strategy::Uniform => "uniform",
+            Strategy::Bsdf => "bsdf",
+            Strategy::Light => "light",
+            Strategy::Mis => "mis",
+        }
+    }
+}
+
+/// Probability of the BSDF component in the MIS mixture.
+pub const MIS_BSDF_WEIGHT: f64 = 0.5;
+
+/// Where a gather happens.
+pub struct GatherPoint<'a> {
+    /// The shading point.
+    pub point: Vec3,
+    /// Its frame.
+    pub frame: ShadingFrame,
+    /// Direction toward the viewer.
+    pub wo: Vec3,
+    /// Its material.
+    pub material: &'a Material,
+    /// The scene's emitters.
+    pub lights: &'a Lights,
+}
+
+fn uniform_sphere(u: [f32; 2]) -> Vec3 {
+    let z = 1.0 - 2.0 * u[0];
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = std::f32::consts::TAU * u[1];
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+impl Strategy {
+    /// The strategy actually usable at a point: light-based ones fall back to BSDF sampling
+    /// in a scene without emitters.
+    fn effective(self, at: &GatherPoint) -> Strategy {
+        match self {
+            Strategy::Light | Strategy::Mis if at.lights.is_empty() => Strategy::Bsdf,
+            other => other,
+        }
+    }
+
+    /// A candidate direction and the strategy's density there (`None`: no direction, a zero).
+    pub fn sample(self, at: &GatherPoint, u: [f32; 2]) -> Option<(Vec3, f64)> {
+        match self.effective(at) {
+            Strategy::Uniform => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
+            Strategy::Bsdf => Some(at.material.sample(&at.frame, u)),
+            Strategy::Light => at.lights.sample(at.point, u),
+            Strategy::Mis => {
+                let w = MIS_BSDF_WEIGHT as f32;
+                let direction = if u[0] < w {
+                    at.material.sample(&at.frame, [u[0] / w, u[1]]).0
+                } else {
+                    at.lights
+                        .sample(at.point, [((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]])?
+                        .0
+                };
+                let pdf = self.pdf(at, direction);
+                (pdf > 0.0).then_some((direction, pdf))
+            }
+        }
+    }
+
+    /// The strategy's density at `direction`.
+    pub fn pdf(self, at: &GatherPoint, direction: Vec3) -> f64 {
+        match self.effective(at) {
+            Strategy::Uniform => 1.0 / (4.0 * PI),
+            Strategy::Bsdf => at.material.pdf(&at.frame, direction),
+            Strategy::Light => at.lights.pdf(at.point, direction),
+            Strategy::Mis => {
+                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, direction)
+                    + (1.0 - MIS_BSDF_WEIGHT) * at.lights.pdf(at.point, direction)
+            }
+        }
+    }
+}
