@@ -184,10 +184,10 @@ pub fn default_world(width: u32, height: u32) -> World {
         });
     }
     let geometry = Geometry::build(inputs);
-    let environment = Environment::Map(EnvironmentMap::new(
+    let environment = Environment::Map(Box::new(EnvironmentMap::new(
         procedural_sky(512, 256),
         glam::DMat3::IDENTITY,
-    ));
+    )));
     let (_, scene_radius) = geometry.bounding_sphere();
     let lights = Lights::new(Some(environment), area, 5, scene_radius as f64);
     let materials = vec![

@@ -215,7 +215,9 @@ fn environment(
             }
             let to_world = plugin.transform("to_world").map_err(at)?;
             let rotation = DMat3::from_mat4(to_world);
-            Ok(Environment::Map(EnvironmentMap::new(image, rotation)))
+            Ok(Environment::Map(Box::new(EnvironmentMap::new(
+                image, rotation,
+            ))))
         }
         other => Err(InputError::at(
             file,

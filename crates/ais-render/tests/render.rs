@@ -6,15 +6,10 @@ use ais_render::integrator::Integrator;
 use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
-use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::process::Command;
 
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ais-render-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
+mod common;
+use common::{npm_package, scratch};
 
 fn settings(integrator: Integrator, spp: u32) -> RenderSettings {
     RenderSettings {
@@ -136,35 +131,13 @@ fn bunny_obj(index_js: &str) -> Option<String> {
     Some(obj)
 }
 
-/// Prints a skip reason where the test harness does not swallow it.
-fn skip(reason: &str) {
-    let _ = writeln!(std::io::stderr(), "SKIPPED the npm bunny test: {reason}");
-}
-
 #[test]
 fn the_stanford_bunny_from_npm_loads_and_renders() {
-    let dir = scratch("bunny");
-    let pack = Command::new("npm")
-        .args(["pack", "bunny@1.0.1", "--silent", "--pack-destination"])
-        .arg(&dir)
-        .output();
-    match pack {
-        Err(e) => return skip(&format!("npm could not be run ({e})")),
-        Ok(out) if !out.status.success() => {
-            return skip(&format!(
-                "`npm pack bunny` failed: {}",
-                String::from_utf8_lossy(&out.stderr).trim()
-            ))
-        }
-        Ok(_) => {}
-    }
-    let untar = Command::new("tar")
-        .args(["xzf", "bunny-1.0.1.tgz"])
-        .current_dir(&dir)
-        .status()
-        .expect("tar runs");
-    assert!(untar.success(), "the npm tarball must unpack");
-    let index = std::fs::read_to_string(dir.join("package/index.js")).unwrap();
+    let Some(package) = npm_package("the npm bunny test", "bunny@1.0.1") else {
+        return;
+    };
+    let dir = package.parent().unwrap().to_path_buf();
+    let index = std::fs::read_to_string(package.join("index.js")).unwrap();
     let obj = bunny_obj(&index).expect("the bunny package has positions and cells");
     std::fs::write(dir.join("bunny.obj"), obj).unwrap();
     let scene = write_scene(

@@ -22,7 +22,7 @@ pub enum Environment {
     /// The same radiance from every direction.
     Constant(Vec3),
     /// A lat-long image.
-    Map(EnvironmentMap),
+    Map(Box<EnvironmentMap>),
 }
 
 /// A lat-long environment image with its sampling distribution.

@@ -1,0 +1,303 @@
+//! Chi-square goodness-of-fit tests of every light and proposal sampler, in the manner of
+//! Mitsuba 3's chi2 tests: sampled directions are binned on a lat-long grid and compared with
+//! the integral of the sampler's own density over each bin.
+
+mod common;
+
+use ais::chi2::chi_square_p_value;
+use ais::mapping::LatLong;
+use ais::rng::Pcg32;
+use ais_render::bsdf::{Material, ShadingFrame};
+use ais_render::geometry::{Sphere, Triangle};
+use ais_render::image_io::{read_image, RgbImage};
+use ais_render::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights};
+use ais_render::proposal::{GatherPoint, Strategy};
+use base64::Engine;
+use glam::{DMat3, Vec3};
+use std::f32::consts::PI;
+
+const ROWS: u32 = 24;
+const SUBDIVISION: u32 = 32;
+const SIGNIFICANCE: f64 = 0.01;
+
+/// Samples `count` directions and returns the chi-square p-value against the integral of
+/// `pdf` over each bin (midpoint rule on equal-area sub-cells). Also checks that each
+/// sample's reported density equals `pdf` at its direction.
+fn fit(
+    count: u32,
+    seed: u64,
+    sample: impl Fn([f32; 2]) -> Option<(Vec3, f64)>,
+    pdf: impl Fn(Vec3) -> f64,
+) -> f64 {
+    let layout = LatLong::new(ROWS);
+    let mut observed = vec![0.0; layout.texel_count()];
+    let mut rng = Pcg32::new(seed, 11);
+    let mut drawn = 0;
+    let mut mismatched = 0;
+    for _ in 0..count {
+        let Some((direction, density)) = sample([rng.next_f32(), rng.next_f32()]) else {
+            continue;
+        };
+        let reference = pdf(direction);
+        // Rounding can move a direction sampled at a texel edge across it: allow that rarely.
+        if (density - reference).abs() > 1e-3 * reference.max(1e-3) {
+            mismatched += 1;
+        }
+        observed[layout.index(layout.texel(direction))] += 1.0;
+        drawn += 1;
+    }
+    assert!(
+        mismatched * 1000 <= drawn,
+        "{mismatched} of {drawn} samples report a density that differs from pdf()"
+    );
+    let mut expected = vec![0.0; layout.texel_count()];
+    let mut total = 0.0;
+    for (index, slot) in expected.iter_mut().enumerate() {
+        let texel = layout.texel_of_index(index);
+        let (z0, z1) = (
+            (PI * texel.row as f32 / ROWS as f32).cos(),
+            (PI * (texel.row + 1) as f32 / ROWS as f32).cos(),
+        );
+        let (phi0, phi1) = (
+            2.0 * PI * texel.column as f32 / layout.width() as f32,
+            2.0 * PI * (texel.column + 1) as f32 / layout.width() as f32,
+        );
+        let cell = (z0 - z1) * (phi1 - phi0) / (SUBDIVISION * SUBDIVISION) as f32;
+        let mut integral = 0.0;
+        for i in 0..SUBDIVISION {
+            for j in 0..SUBDIVISION {
+                let z = z0 + (z1 - z0) * (i as f32 + 0.5) / SUBDIVISION as f32;
+                let phi = phi0 + (phi1 - phi0) * (j as f32 + 0.5) / SUBDIVISION as f32;
+                let r = (1.0 - z * z).max(0.0).sqrt();
+                integral += pdf(Vec3::new(r * phi.cos(), r * phi.sin(), z)) * cell as f64;
+            }
+        }
+        total += integral;
+        *slot = integral;
+    }
+    assert!(
+        (total - 1.0).abs() < 0.02,
+        "the density integrates to {total}, not 1"
+    );
+    for e in &mut expected {
+        *e *= drawn as f64 / total;
+    }
+    chi_square_p_value(&observed, &expected)
+}
+
+fn gradient_with_sun(width: usize, height: usize) -> RgbImage {
+    let mut image = RgbImage::new(width, height);
+    for row in 0..height {
+        for column in 0..width {
+            let v = 0.2 + row as f32 / height as f32 + 0.5 * (column as f32 / width as f32);
+            image.pixels[row * width + column] = [v, 0.8 * v, 0.6 * v];
+        }
+    }
+    // A tiny, very bright sun: one texel.
+    image.pixels[(height / 3) * width + width / 5] = [20_000.0; 3];
+    image
+}
+
+#[test]
+fn envmap_orientation_follows_mitsuba() {
+    // Mitsuba: u = atan2(x, -z) / 2π, v = acos(y) / π in the emitter's frame.
+    let (width, height) = (64, 32);
+    let mut image = RgbImage::new(width, height);
+    image.pixels[(height / 2) * width + width / 4] = [1.0, 0.0, 0.0]; // u = 0.25, v = 0.5: +x
+    image.pixels[(height / 2) * width] = [0.0, 1.0, 0.0]; // u = 0, v = 0.5: −z
+    image.pixels[0] = [0.0, 0.0, 1.0]; // v = 0: +y (any u)
+    let env = Environment::Map(Box::new(EnvironmentMap::new(image, DMat3::IDENTITY)));
+    let dir = |x: f32, y: f32, z: f32| Vec3::new(x, y, z).normalize();
+    assert_eq!(env.radiance(dir(1.0, -0.01, 0.001)), Vec3::X);
+    assert_eq!(env.radiance(dir(0.001, -0.01, -1.0)), Vec3::Y);
+    assert_eq!(env.radiance(dir(0.0, 1.0, -0.01)), Vec3::Z);
+    // to_world rotates the frame: a 90° turn about +y moves +x to −z.
+    let mut rotated_image = RgbImage::new(width, height);
+    rotated_image.pixels[(height / 2) * width + width / 4] = [1.0, 0.0, 0.0];
+    let rotation = DMat3::from_rotation_y(std::f64::consts::FRAC_PI_2);
+    let rotated = Environment::Map(Box::new(EnvironmentMap::new(rotated_image, rotation)));
+    assert_eq!(rotated.radiance(dir(0.001, -0.01, -1.0)), Vec3::X);
+}
+
+#[test]
+fn synthetic_envmap_with_a_tiny_sun_fits() {
+    let rotation = DMat3::from_rotation_x(0.5) * DMat3::from_rotation_z(0.3);
+    let env = Environment::Map(Box::new(EnvironmentMap::new(
+        gradient_with_sun(64, 32),
+        rotation,
+    )));
+    let p = fit(200_000, 1, |u| Some(env.sample(u)), |d| env.pdf(d));
+    assert!(p > SIGNIFICANCE, "p = {p}");
+    // Inversion: the u that produced a direction maps back to it.
+    let mut rng = Pcg32::new(2, 2);
+    for _ in 0..1000 {
+        let u = [rng.next_f32(), rng.next_f32()];
+        let (d, _) = env.sample(u);
+        let back = env.invert(d).unwrap();
+        let (d2, _) = env.sample([back[0] as f32, back[1] as f32]);
+        assert!((d - d2).length() < 1e-3, "{d:?} vs {d2:?}");
+    }
+}
+
+#[test]
+fn real_hdri_from_npm_fits() {
+    let Some(package) = common::npm_package("the npm HDRI chi2 test", "@pmndrs/assets@1.7.0")
+    else {
+        return;
+    };
+    let js = std::fs::read_to_string(package.join("hdri/dawn.exr.js")).unwrap();
+    let start = js.find("base64,").expect("a data URL") + "base64,".len();
+    let end = start + js[start..].find('\'').expect("the closing quote");
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(&js[start..end])
+        .expect("valid base64");
+    let path = common::scratch("hdri").join("dawn.exr");
+    std::fs::write(&path, bytes).unwrap();
+    let loaded = read_image(&path).unwrap();
+    assert_eq!((loaded.image.width, loaded.image.height), (512, 256));
+    let env = Environment::Map(Box::new(EnvironmentMap::new(loaded.image, DMat3::IDENTITY)));
+    let p = fit(200_000, 3, |u| Some(env.sample(u)), |d| env.pdf(d));
+    assert!(p > SIGNIFICANCE, "p = {p}");
+}
+
+#[test]
+fn sphere_light_cone_sampling_fits() {
+    let light = AreaLight {
+        shape: AreaShape::Sphere {
+            sphere: Sphere {
+                center: Vec3::new(0.5, 0.8, 2.0),
+                radius: 0.9,
+            },
+            flipped: false,
+        },
+        radiance: Vec3::ONE,
+        shape_index: 0,
+    };
+    let point = Vec3::new(0.1, -0.2, 0.0);
+    let p = fit(
+        200_000,
+        4,
+        |u| light.sample(point, u).map(|s| (s.direction, s.pdf)),
+        |d| light.pdf(point, d),
+    );
+    assert!(p > SIGNIFICANCE, "p = {p}");
+}
+
+fn rectangle_light() -> AreaLight {
+    let (a, b, c, d) = (
+        Vec3::new(-0.5, -0.4, 1.0),
+        Vec3::new(0.9, -0.4, 1.2),
+        Vec3::new(0.9, 0.7, 1.2),
+        Vec3::new(-0.5, 0.7, 1.0),
+    );
+    let triangles = vec![
+        Triangle {
+            vertices: [a, b, c],
+            mesh: 0,
+            index: 0,
+        },
+        Triangle {
+            vertices: [a, c, d],
+            mesh: 0,
+            index: 1,
+        },
+    ];
+    AreaLight::from_triangles(triangles, Vec3::ONE, 0)
+}
+
+#[test]
+fn rectangle_light_area_sampling_fits() {
+    let light = rectangle_light();
+    let point = Vec3::new(0.2, 0.1, 0.0);
+    let p = fit(
+        200_000,
+        5,
+        |u| light.sample(point, u).map(|s| (s.direction, s.pdf)),
+        |d| light.pdf(point, d),
+    );
+    assert!(p > SIGNIFICANCE, "p = {p}");
+}
+
+fn mixed_lights() -> Lights {
+    let sphere = AreaLight {
+        shape: AreaShape::Sphere {
+            sphere: Sphere {
+                center: Vec3::new(-1.5, 0.5, 1.0),
+                radius: 0.4,
+            },
+            flipped: false,
+        },
+        radiance: Vec3::splat(5.0),
+        shape_index: 1,
+    };
+    let env = Environment::Map(Box::new(EnvironmentMap::new(
+        gradient_with_sun(32, 16),
+        DMat3::IDENTITY,
+    )));
+    Lights::new(Some(env), vec![rectangle_light(), sphere], 2, 3.0)
+}
+
+#[test]
+fn light_selection_mixture_fits() {
+    let lights = mixed_lights();
+    let point = Vec3::ZERO;
+    let p = fit(
+        200_000,
+        6,
+        |u| lights.sample(point, u),
+        |d| lights.pdf(point, d),
+    );
+    assert!(p > SIGNIFICANCE, "p = {p}");
+}
+
+#[test]
+fn every_gather_proposal_fits() {
+    let lights = mixed_lights();
+    let material = Material::default();
+    let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
+    let wo = Vec3::new(-0.3, 0.2, 1.0).normalize();
+    let frame = ShadingFrame::new(&material, normal, normal, wo);
+    let at = GatherPoint {
+        point: Vec3::ZERO,
+        frame,
+        wo,
+        material: &material,
+        lights: &lights,
+    };
+    for (seed, strategy) in [
+        Strategy::Uniform,
+        Strategy::Bsdf,
+        Strategy::Light,
+        Strategy::Mis,
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let p = fit(
+            200_000,
+            10 + seed as u64,
+            |u| strategy.sample(&at, u),
+            |d| strategy.pdf(&at, d),
+        );
+        assert!(p > SIGNIFICANCE, "{strategy:?}: p = {p}");
+    }
+}
+
+#[test]
+fn the_fit_rejects_a_wrong_density() {
+    // Cone sampling checked against the rectangle's density must fail.
+    let light = rectangle_light();
+    let point = Vec3::ZERO;
+    let env = Environment::Constant(Vec3::ONE);
+    let p = fit(
+        50_000,
+        7,
+        |u| {
+            light
+                .sample(point, u)
+                .map(|s| (s.direction, env.pdf(s.direction)))
+        },
+        |d| env.pdf(d),
+    );
+    assert!(p < 1e-6, "p = {p}");
+}
