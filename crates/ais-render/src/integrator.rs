@@ -68,6 +68,8 @@ pub struct GatherSettings {
     pub tol: f32,
     /// The map's height in texels.
     pub map_height: u32,
+    /// Halton (the talk's) or independent random candidates.
+    pub placement: ais::Placement,
 }
 
 impl Default for GatherSettings {
@@ -75,10 +77,13 @@ impl Default for GatherSettings {
         let map = MapConfig::default();
         GatherSettings {
             strategy: Strategy::Mis,
-            ais: AisMode::Aggressive,
+            // Measured: per-batch AIS with Halton placement loses to AIS off in every room
+            // and scene tried so far (BENCHMARKS.md), so the renderer starts with it off.
+            ais: AisMode::Off,
             rays: 64,
             tol: map.tol,
             map_height: map.height,
+            placement: ais::Placement::Halton,
         }
     }
 }
@@ -89,6 +94,7 @@ impl GatherSettings {
     pub fn batch_config(&self) -> BatchConfig {
         let base = BatchConfig {
             stopping: Stopping::CandidateBudget,
+            placement: self.placement,
             ..BatchConfig::default()
         };
         match self.ais {
