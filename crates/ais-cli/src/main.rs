@@ -113,6 +113,9 @@ struct RenderArgs {
     /// Affinity-map height in texels (width is twice this).
     #[arg(long)]
     map_res: Option<u32>,
+    /// Candidate placement: halton (scrambled per batch) or random.
+    #[arg(long)]
+    placement: Option<String>,
     /// Also write the mean traced gather rays per camera sample, per pixel, to this EXR.
     #[arg(long)]
     aov_traced: Option<PathBuf>,
@@ -173,6 +176,13 @@ fn gather_settings(
         settings.ais = AisMode::parse(&name).ok_or_else(|| {
             format!("unknown AIS mode \"{name}\" (off, aggressive, conservative)")
         })?;
+    }
+    if let Some(name) = &args.placement {
+        settings.placement = match name.as_str() {
+            "halton" => ais::Placement::Halton,
+            "random" => ais::Placement::Random,
+            other => return Err(format!("unknown placement \"{other}\" (halton, random)")),
+        };
     }
     settings.rays = args.rays.unwrap_or(settings.rays);
     settings.tol = args.tol.unwrap_or(settings.tol);

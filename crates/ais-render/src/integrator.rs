@@ -80,7 +80,7 @@ impl Default for GatherSettings {
             // Measured: per-batch AIS with Halton placement loses to AIS off in every room
             // and scene tried so far (BENCHMARKS.md), so the renderer starts with it off.
             ais: AisMode::Off,
-            rays: 64,
+            rays: 16,
             tol: map.tol,
             map_height: map.height,
             placement: ais::Placement::Halton,

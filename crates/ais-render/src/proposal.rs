@@ -88,9 +88,10 @@ impl Strategy {
                 let direction = if u[0] < w {
                     at.material.sample(&at.frame, [u[0] / w, u[1]]).0
                 } else {
-                    at.lights
-                        .sample(at.point, [((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]])?
-                        .0
+                    at.lights.sample_direction(
+                        at.point,
+                        [((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]],
+                    )?
                 };
                 let pdf = self.pdf(at, direction);
                 (pdf > 0.0).then_some((direction, pdf))

@@ -63,17 +63,23 @@ impl Lights {
             .map_or(0.0, |c| c.bin_probability(index))
     }
 
-    /// A direction from `point` drawn by light sampling, with the density of the whole
-    /// light-sampling strategy at that direction (all lights that could produce it).
-    pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
+    /// A direction from `point` drawn by light sampling: a light chosen in proportion to its
+    /// power, then a direction toward it. Its density is [`Lights::pdf`] (all lights that
+    /// could have produced it), which callers evaluate once.
+    pub fn sample_direction(&self, point: Vec3, u: [f32; 2]) -> Option<Vec3> {
         let choice = self.choice.as_ref()?;
         let (x, _, index) = choice.sample(u[0] as f64);
         let u0 = ((x * choice.len() as f64 - index as f64).clamp(0.0, 1.0 - 1e-7)) as f32;
-        let direction = if index < self.area.len() {
-            self.area[index].sample(point, [u0, u[1]])?.direction
+        if index < self.area.len() {
+            Some(self.area[index].sample(point, [u0, u[1]])?.direction)
         } else {
-            self.environment.as_ref()?.sample([u0, u[1]]).0
-        };
+            Some(self.environment.as_ref()?.sample([u0, u[1]]).0)
+        }
+    }
+
+    /// [`Lights::sample_direction`] with its density.
+    pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
+        let direction = self.sample_direction(point, u)?;
         let pdf = self.pdf(point, direction);
         (pdf > 0.0).then_some((direction, pdf))
     }

@@ -1,0 +1,63 @@
+//! The shipped scenes in `scenes/` load without warnings and render.
+
+mod common;
+
+use ais_render::integrator::{GatherSettings, Integrator};
+use ais_render::render::{render, RenderSettings};
+use ais_render::scene::load_scene;
+use ais_render::world::World;
+use std::path::PathBuf;
+use std::process::Command;
+
+fn scenes_folder() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
+}
+
+#[test]
+fn shipped_scenes_load_and_render() {
+    let folder = scenes_folder();
+    if !folder.join("assets/sky.hdr").exists() {
+        let made = Command::new("python3")
+            .arg(folder.join("make_assets.py"))
+            .status();
+        match made {
+            Ok(status) if status.success() => {}
+            Ok(status) => panic!("scenes/make_assets.py failed: {status}"),
+            Err(e) => {
+                return common::skip(
+                    "the shipped-scenes test",
+                    &format!("python3 could not be run ({e})"),
+                )
+            }
+        }
+    }
+    for name in ["open", "occluded", "interior"] {
+        let path = folder.join(format!("{name}.xml"));
+        let overrides = [
+            ("res_x".to_string(), "32".to_string()),
+            ("res_y".to_string(), "18".to_string()),
+        ];
+        let description = load_scene(&path, &overrides).unwrap();
+        assert!(
+            description.warnings.is_empty(),
+            "{name}: {:?}",
+            description.warnings
+        );
+        assert_eq!(description.integrator.as_ref().unwrap().kind, "gather");
+        let world = World::from_description(description).unwrap();
+        assert!(world.warnings.is_empty(), "{name}: {:?}", world.warnings);
+        assert!(world.lights.environment.is_some(), "{name} has a sky");
+        let output = render(
+            &world,
+            &RenderSettings {
+                samples_per_pixel: 1,
+                integrator: Integrator::Gather(GatherSettings::default()),
+                seed: 0,
+                progress: false,
+            },
+        );
+        let mean: f64 = output.image.pixels.iter().map(|p| p[1] as f64).sum::<f64>()
+            / output.image.pixels.len() as f64;
+        assert!(mean.is_finite() && mean > 0.0, "{name}: mean {mean}");
+    }
+}
