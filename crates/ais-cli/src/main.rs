@@ -24,7 +24,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Render a Mitsuba 3 XML scene, or the built-in default scene when none is given.
-    Render(RenderArgs),
+    Render(Box<RenderArgs>),
     /// Measure BVH build time and ray throughput on the built-in default scene.
     Bench(BenchArgs),
 }
@@ -371,7 +371,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Render(args) => run_render(args),
+        Command::Render(args) => run_render(*args),
         Command::Bench(args) => run_bench(args),
     };
     match result {
