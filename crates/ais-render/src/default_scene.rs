@@ -191,14 +191,8 @@ pub fn default_world(width: u32, height: u32) -> World {
     let (_, scene_radius) = geometry.bounding_sphere();
     let lights = Lights::new(Some(environment), area, 5, scene_radius as f64);
     let materials = vec![
-        Material {
-            reflectance: Vec3::splat(0.7),
-            two_sided: false,
-        },
-        Material {
-            reflectance: Vec3::new(0.45, 0.42, 0.38),
-            two_sided: false,
-        },
+        Material::diffuse(Vec3::splat(0.7)),
+        Material::diffuse(Vec3::new(0.45, 0.42, 0.38)),
         Material::default(),
         Material::default(),
         Material::default(),

@@ -81,12 +81,12 @@ impl Strategy {
     pub fn sample(self, at: &GatherPoint, u: [f32; 2]) -> Option<(Vec3, f64)> {
         match self.effective(at) {
             Strategy::Uniform => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
-            Strategy::Bsdf => Some(at.material.sample(&at.frame, u)),
+            Strategy::Bsdf => Some(at.material.sample(&at.frame, at.wo, u)),
             Strategy::Light => at.lights.sample(at.point, u),
             Strategy::Mis => {
                 let w = MIS_BSDF_WEIGHT as f32;
                 let direction = if u[0] < w {
-                    at.material.sample(&at.frame, [u[0] / w, u[1]]).0
+                    at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]).0
                 } else {
                     at.lights.sample_direction(
                         at.point,
@@ -103,10 +103,10 @@ impl Strategy {
     pub fn pdf(self, at: &GatherPoint, direction: Vec3) -> f64 {
         match self.effective(at) {
             Strategy::Uniform => 1.0 / (4.0 * PI),
-            Strategy::Bsdf => at.material.pdf(&at.frame, direction),
+            Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, direction),
             Strategy::Light => at.lights.pdf(at.point, direction),
             Strategy::Mis => {
-                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, direction)
+                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, direction)
                     + (1.0 - MIS_BSDF_WEIGHT) * at.lights.pdf(at.point, direction)
             }
         }
