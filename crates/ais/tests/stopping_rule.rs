@@ -18,7 +18,7 @@ const BATCHES: u32 = 20_000;
 
 /// A fixed map whose affinity varies with direction: texels above 45° elevation keep 1,
 /// the others are learned down to 1/4.
-fn fixed_batch(stopping: Stopping) -> Batch<f64> {
+fn fixed_batch(stopping: Stopping, candidate_cap: u32) -> Batch<f64> {
     let map_config = MapConfig {
         height: 8,
         tol: f32::INFINITY,
@@ -30,7 +30,7 @@ fn fixed_batch(stopping: Stopping) -> Batch<f64> {
         learning: Learning::Off,
         placement: Placement::Random,
         stopping,
-        ..BatchConfig::default()
+        candidate_cap,
     };
     let mut map = AffinityMap::new(map_config).unwrap();
     let layout = map.level_layout(0);
@@ -48,11 +48,11 @@ fn fixed_batch(stopping: Stopping) -> Batch<f64> {
     batch
 }
 
-fn run_fixed(stopping: Stopping, n: u32) -> (Summary, f64) {
+/// Batches of `n` rays on the open scene with a prepared (fixed-map) batch.
+fn run_on_open_scene(batch: &mut Batch<f64>, n: u32) -> (Summary, f64) {
     let scene = Scene::open();
-    let mut batch = fixed_batch(stopping);
     let summary = summarize_with(
-        &mut batch,
+        batch,
         &scene,
         Proposal::CosineHemisphere,
         n,
@@ -66,8 +66,8 @@ fn run_fixed(stopping: Stopping, n: u32) -> (Summary, f64) {
 #[test]
 fn stopping_at_n_is_biased_and_n_plus_one_is_not() {
     for n in [1, 4] {
-        let (at_n, exact) = run_fixed(Stopping::AtN, n);
-        let (n_plus_one, _) = run_fixed(Stopping::DropLast, n);
+        let (at_n, exact) = run_on_open_scene(&mut fixed_batch(Stopping::AtN, 64), n);
+        let (n_plus_one, _) = run_on_open_scene(&mut fixed_batch(Stopping::DropLast, 64), n);
         let relative = at_n.mean / exact - 1.0;
         println!(
             "n = {n}: stop at n {:+.2}% (z {:+.1}); n+1 {:+.2}% (z {:+.1})",
@@ -129,29 +129,15 @@ fn candidate_cap_ends_the_batch_and_stays_unbiased_for_a_fixed_map() {
     // A map of affinity 1/4 below 45° and a cap of 2 candidates per ray: a fifth of the
     // batches end at the cap, and the mixture of n+1 estimates and plain averages over the
     // capped candidates must still be unbiased.
-    let scene = Scene::open();
-    let mut batch = fixed_batch(Stopping::DropLast);
-    let mut config = *batch.config();
-    config.candidate_cap = 2;
-    let map = batch.map().unwrap().clone();
-    batch = Batch::new(config).unwrap();
-    batch.map_mut().unwrap().copy_from(&map);
-    let summary = summarize_with(
-        &mut batch,
-        &scene,
-        Proposal::CosineHemisphere,
-        8,
-        BATCHES,
-        GatherTarget::Normal,
-        MapStart::Current,
-    );
+    let mut batch = fixed_batch(Stopping::DropLast, 2);
+    let (summary, exact) = run_on_open_scene(&mut batch, 8);
     let cap_share = batch.stats().cap_hits as f64 / BATCHES as f64;
     println!(
         "cap hit in {:.0}% of batches, z {:+.2}",
         cap_share * 100.0,
-        summary.z(scene.exact())
+        summary.z(exact)
     );
     assert!(cap_share > 0.15);
-    assert!(summary.z(scene.exact()).abs() < 4.0);
+    assert!(summary.z(exact).abs() < 4.0);
     assert!(batch.stats().candidates <= 16 * BATCHES as u64);
 }

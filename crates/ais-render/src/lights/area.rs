@@ -48,6 +48,21 @@ pub struct AreaLight {
     pub shape_index: u32,
 }
 
+/// The cone of directions from `point` that a sphere subtends: its axis and the cosine of
+/// its half-angle (`None` from inside the sphere, where there is no cone).
+fn subtended_cone(sphere: &Sphere, point: Vec3) -> Option<(Vec3, f64)> {
+    let to_center = sphere.center - point;
+    let distance_squared = to_center.length_squared() as f64;
+    let r2 = (sphere.radius as f64).powi(2);
+    if distance_squared <= r2 {
+        return None;
+    }
+    Some((
+        to_center.normalize(),
+        (1.0 - r2 / distance_squared).max(0.0).sqrt(),
+    ))
+}
+
 impl AreaLight {
     /// Triangles (wound toward the emitting side) as a light.
     pub fn from_triangles(triangles: Vec<Triangle>, radiance: Vec3, shape_index: u32) -> Self {
@@ -90,17 +105,10 @@ impl AreaLight {
     pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<AreaSample> {
         match &self.shape {
             AreaShape::Sphere { sphere, .. } => {
-                let to_center = sphere.center - point;
-                let distance_squared = to_center.length_squared() as f64;
-                let r2 = (sphere.radius as f64).powi(2);
-                if distance_squared <= r2 {
-                    return None; // inside the sphere: no cone to sample
-                }
-                let cos_max = (1.0 - r2 / distance_squared).max(0.0).sqrt();
+                let (axis, cos_max) = subtended_cone(sphere, point)?;
                 let cos_theta = 1.0 - u[0] as f64 * (1.0 - cos_max);
                 let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
                 let phi = 2.0 * PI * u[1] as f64;
-                let axis = to_center.normalize();
                 let (t, b) = crate::integrator::basis(axis);
                 let direction = (t * (sin_theta * phi.cos()) as f32
                     + b * (sin_theta * phi.sin()) as f32
@@ -147,14 +155,10 @@ impl AreaLight {
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
         match &self.shape {
             AreaShape::Sphere { sphere, .. } => {
-                let to_center = sphere.center - point;
-                let distance_squared = to_center.length_squared() as f64;
-                let r2 = (sphere.radius as f64).powi(2);
-                if distance_squared <= r2 {
+                let Some((axis, cos_max)) = subtended_cone(sphere, point) else {
                     return 0.0;
-                }
-                let cos_max = (1.0 - r2 / distance_squared).max(0.0).sqrt();
-                let cosine = to_center.normalize().dot(direction) as f64;
+                };
+                let cosine = axis.dot(direction) as f64;
                 if cosine >= cos_max {
                     1.0 / (2.0 * PI * (1.0 - cos_max))
                 } else {
