@@ -360,6 +360,13 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             stats.rejected_roulette as f64 / gathers,
             stats.resets
         );
+        let cpu = seconds * rayon::current_num_threads() as f64;
+        println!(
+            "AIS code     ≈ {:.3} s of {cpu:.3} thread-seconds ({:.1}%; 1 in {} gathers replayed and timed)",
+            output.ais_time.as_secs_f64(),
+            100.0 * output.ais_time.as_secs_f64() / cpu.max(1e-9),
+            ais_render::ais_timer::SAMPLING
+        );
     }
     println!("wrote        {}", args.output.display());
     if !args.no_preview {

@@ -127,6 +127,8 @@ pub struct SampleContext {
     pub counts: RayCounts,
     /// The gather's batch driver (allocated on first use).
     pub batch: Option<Batch<[f32; 3]>>,
+    /// Time spent in AIS calls (sampled).
+    pub ais_timer: crate::ais_timer::AisTimer,
 }
 
 /// What to compute at each camera sample.
@@ -240,10 +242,16 @@ fn gather(
         material,
         lights: &world.lights,
     };
-    let batch = context.batch.get_or_insert_with(|| {
+    let SampleContext {
+        counts,
+        batch,
+        ais_timer: timer,
+    } = context;
+    let batch = batch.get_or_insert_with(|| {
         Batch::new(settings.batch_config()).expect("valid gather configuration")
     });
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+    timer.start_gather();
     batch.begin(settings.rays, seed, MapStart::Empty);
     while let Some(candidate) = batch.next_candidate() {
         let Some((direction, pdf)) = settings
@@ -251,10 +259,12 @@ fn gather(
             .sample(&at, candidate.u)
             .filter(|s| s.1 > 0.0)
         else {
+            timer.decided(frame.normal, false);
             batch.decide(frame.normal, false);
             continue;
         };
         let in_support = material.in_support(&frame, wo, direction);
+        timer.decided(direction, in_support);
         if let Decision::Trace { .. } = batch.decide(direction, in_support) {
             let mut leaving = spawn_ray(hit.point, frame.geometric, direction);
             let (unoccluded, distance) = world.lights.unoccluded(&leaving);
@@ -264,7 +274,7 @@ fn gather(
                 Vec3::ZERO
             } else {
                 leaving.t_max = distance * (1.0 - 1e-4);
-                context.counts.occlusion += 1;
+                counts.occlusion += 1;
                 if world.geometry.occluded(&leaving) {
                     Vec3::ZERO
                 } else {
@@ -272,13 +282,14 @@ fn gather(
                 }
             };
             let value = material.eval(&frame, wo, direction) * actual / pdf as f32;
-            batch.record(
-                value.to_array(),
-                rating(luminance(actual), luminance(unoccluded)),
-            );
+            let rating = rating(luminance(actual), luminance(unoccluded));
+            timer.recorded(value.to_array(), rating);
+            batch.record(value.to_array(), rating);
         }
     }
-    emitted + Vec3::from(batch.finish().value)
+    let estimate = batch.finish();
+    timer.end_gather(batch.config(), settings.rays, seed);
+    emitted + Vec3::from(estimate.value)
 }
 
 #[cfg(test)]

@@ -34,6 +34,8 @@ pub struct RenderOutput {
     pub rays: RayCounts,
     /// Counts of the AIS batches (gather integrator only).
     pub ais: ais::Stats,
+    /// Estimated time spent in AIS calls, summed over threads (see [`crate::ais_timer`]).
+    pub ais_time: Duration,
     /// Mean traced gather rays per camera sample, per pixel (an AOV).
     pub traced_per_sample: Vec<f32>,
     /// Wall time of the render loop.
@@ -68,7 +70,15 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
         ProgressBar::hidden()
     };
     let started = Instant::now();
-    type TileResult = (usize, usize, Vec<[f32; 3]>, Vec<f32>, RayCounts, ais::Stats);
+    type TileResult = (
+        usize,
+        usize,
+        Vec<[f32; 3]>,
+        Vec<f32>,
+        RayCounts,
+        ais::Stats,
+        Duration,
+    );
     let results: Vec<TileResult> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
@@ -105,7 +115,8 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
                 .as_ref()
                 .map(|b| *b.stats())
                 .unwrap_or_default();
-            (x0, y0, pixels, traced, context.counts, stats)
+            let ais_time = context.ais_timer.estimate();
+            (x0, y0, pixels, traced, context.counts, stats, ais_time)
         })
         .collect();
     progress.finish_and_clear();
@@ -113,8 +124,10 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
     let mut rays = RayCounts::default();
     let mut ais_stats = ais::Stats::default();
     let mut traced_per_sample = vec![0.0; width * height];
-    for (x0, y0, pixels, traced, counts, stats) in results {
+    let mut ais_time = Duration::ZERO;
+    for (x0, y0, pixels, traced, counts, stats, time) in results {
         rays.merge(counts);
+        ais_time += time;
         ais_stats.merge(&stats);
         let tile_width = (x0 + TILE_SIZE).min(width) - x0;
         for (i, (value, traced)) in pixels.into_iter().zip(traced).enumerate() {
@@ -127,6 +140,7 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
         image: film.image(),
         rays,
         ais: ais_stats,
+        ais_time,
         traced_per_sample,
         time: started.elapsed(),
     }

@@ -22,23 +22,36 @@ fn settings(integrator: Integrator, spp: u32) -> RenderSettings {
 
 #[test]
 fn images_are_bit_identical_at_one_and_two_threads() {
+    // Both the gather (with AIS and its sampled timing) and ambient occlusion.
     let world = default_world(48, 27);
     let ao = Integrator::AmbientOcclusion {
         rays: 4,
         distance: 1.0,
     };
-    let render_with = |threads: usize| {
+    let gather = Integrator::Gather(ais_render::integrator::GatherSettings {
+        ais: ais_render::integrator::AisMode::Aggressive,
+        ..Default::default()
+    });
+    let render_with = |threads: usize, integrator: Integrator| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| render(&world, &settings(ao, 2)))
+            .install(|| render(&world, &settings(integrator, 2)))
     };
-    let one = render_with(1);
-    let two = render_with(2);
     let bits = |image: &ais_render::image_io::RgbImage| -> Vec<u32> {
         image.pixels.iter().flatten().map(|c| c.to_bits()).collect()
     };
+    let lit_one = render_with(1, gather);
+    let lit_two = render_with(2, gather);
+    assert_eq!(bits(&lit_one.image), bits(&lit_two.image));
+    assert_eq!(lit_one.ais, lit_two.ais);
+    assert!(
+        lit_one.ais_time.as_nanos() > 0,
+        "the AIS time estimate is measured"
+    );
+    let one = render_with(1, ao);
+    let two = render_with(2, ao);
     assert_eq!(bits(&one.image), bits(&two.image));
     assert_eq!(one.rays, two.rays);
     // The image is not trivially uniform: the sculpture occludes.
