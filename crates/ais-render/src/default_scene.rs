@@ -11,7 +11,7 @@ use crate::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights};
 use crate::mesh::TriangleMesh;
 use crate::scene::{look_at, CameraDescription, FovAxis, SceneDescription};
 use crate::shapes;
-use crate::world::emitting_triangles;
+use crate::world::area_light;
 use crate::world::World;
 use glam::{DMat4, DVec3, Vec3};
 use std::f32::consts::{PI, TAU};
@@ -163,8 +163,10 @@ pub fn default_world(width: u32, height: u32) -> World {
             flip_normals: false,
         },
     ];
-    let mut area = vec![AreaLight::from_triangles(
-        emitting_triangles(&panel, false),
+    let mut area = vec![area_light(
+        &panel,
+        true,
+        false,
         Vec3::new(12.0, 12.0, 11.0),
         2,
     )];

@@ -5,7 +5,7 @@ use crate::camera::Camera;
 use crate::error::InputError;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
 use crate::image_io::read_image;
-use crate::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights};
+use crate::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights, Rectangle};
 use crate::mesh::{load_mesh, validate, TriangleMesh};
 use crate::scene::{self, Plugin, Property, SceneDescription};
 use crate::shapes;
@@ -92,8 +92,11 @@ impl World {
             })?;
             warnings.extend(checked.warnings);
             if let Some(radiance) = radiance {
-                area_lights.push(AreaLight::from_triangles(
-                    emitting_triangles(&checked.mesh, shape.flip_normals),
+                let is_rectangle = shape.geometry == scene::ShapeGeometry::Rectangle;
+                area_lights.push(area_light(
+                    &checked.mesh,
+                    is_rectangle,
+                    shape.flip_normals,
                     radiance,
                     shape_index as u32,
                 ));
@@ -134,6 +137,32 @@ impl World {
             warnings,
         })
     }
+}
+
+/// A mesh as an area light: a rectangle (Mitsuba's `rectangle` shape, edges still
+/// orthogonal after `to_world`) is sampled by solid angle, anything else by area.
+pub fn area_light(
+    mesh: &TriangleMesh,
+    is_rectangle: bool,
+    flip_normals: bool,
+    radiance: Vec3,
+    shape_index: u32,
+) -> AreaLight {
+    if is_rectangle && mesh.positions.len() == 4 {
+        let p = &mesh.positions;
+        if let Some(rectangle) = Rectangle::new(p[0], p[1] - p[0], p[3] - p[0], flip_normals) {
+            return AreaLight {
+                shape: AreaShape::Rectangle(rectangle),
+                radiance,
+                shape_index,
+            };
+        }
+    }
+    AreaLight::from_triangles(
+        emitting_triangles(mesh, flip_normals),
+        radiance,
+        shape_index,
+    )
 }
 
 /// The triangles of a mesh as a light, wound toward the emitting side.

@@ -10,7 +10,7 @@ use ais::rng::Pcg32;
 use ais_render::bsdf::{Ggx, Material, Scattering, ShadingFrame};
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
-use ais_render::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights};
+use ais_render::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights, Rectangle};
 use ais_render::proposal::{GatherPoint, Strategy};
 use base64::Engine;
 use glam::{DMat3, Vec3};
@@ -397,4 +397,105 @@ fn microfacet_bsdfs_do_not_create_energy() {
             );
         }
     }
+}
+
+fn solid_angle_rectangle() -> AreaLight {
+    let rectangle = Rectangle::new(
+        Vec3::new(-0.5, -0.4, 1.0),
+        Vec3::new(1.4, 0.0, 0.2),
+        Vec3::new(0.0, 1.1, 0.0),
+        false,
+    )
+    .unwrap();
+    AreaLight {
+        shape: AreaShape::Rectangle(rectangle),
+        radiance: Vec3::ONE,
+        shape_index: 0,
+    }
+}
+
+#[test]
+fn spherical_rectangle_sampling_fits() {
+    let light = solid_angle_rectangle();
+    for (seed, point) in [Vec3::new(0.2, 0.1, 0.0), Vec3::new(1.2, 0.2, 0.2)]
+        .into_iter()
+        .enumerate()
+    {
+        let p = fit(
+            200_000,
+            50 + seed as u64,
+            |u| light.sample(point, u).map(|s| (s.direction, s.pdf)),
+            |d| light.pdf(point, d),
+        );
+        assert!(p > SIGNIFICANCE, "point {seed}: p = {p}");
+    }
+}
+
+/// Irradiance at the origin (normal +z) from a unit-radiance polygon, by Lambert's formula:
+/// E = ½ Σ γ_i (n · u_i), γ_i the angle an edge subtends and u_i the unit normal of the
+/// plane through the origin and that edge.
+fn polygon_irradiance(vertices: &[Vec3]) -> f64 {
+    let mut sum = 0.0;
+    for i in 0..vertices.len() {
+        let a = vertices[i].normalize().as_dvec3();
+        let b = vertices[(i + 1) % vertices.len()].normalize().as_dvec3();
+        let gamma = a.dot(b).clamp(-1.0, 1.0).acos();
+        sum += gamma * a.cross(b).normalize().z;
+    }
+    0.5 * sum.abs()
+}
+
+#[test]
+fn solid_angle_sampling_beats_area_sampling_near_a_rectangle_light() {
+    // A 2 × 2 light only 0.3 above the receiver: area sampling suffers from 1/r² and cos.
+    let (corner, ex, ey) = (
+        Vec3::new(-1.0, -1.0, 0.3),
+        Vec3::new(2.0, 0.0, 0.0),
+        Vec3::new(0.0, 2.0, 0.0),
+    );
+    let spherical = AreaLight {
+        shape: AreaShape::Rectangle(Rectangle::new(corner, ex, ey, true).unwrap()),
+        radiance: Vec3::ONE,
+        shape_index: 0,
+    };
+    let triangles = vec![
+        Triangle {
+            vertices: [corner, corner + ex, corner + ex + ey],
+            mesh: 0,
+            index: 0,
+        },
+        Triangle {
+            vertices: [corner, corner + ex + ey, corner + ey],
+            mesh: 0,
+            index: 1,
+        },
+    ];
+    let by_area = AreaLight::from_triangles(triangles, Vec3::ONE, 0);
+    let exact = polygon_irradiance(&[corner, corner + ex, corner + ex + ey, corner + ey]);
+    let mut variances = Vec::new();
+    for (seed, light) in [spherical, by_area].iter().enumerate() {
+        let mut rng = Pcg32::new(60 + seed as u64, 1);
+        let (mut sum, mut sum_sq, n) = (0.0, 0.0, 200_000);
+        for _ in 0..n {
+            let value = light
+                .sample(Vec3::ZERO, [rng.next_f32(), rng.next_f32()])
+                .map_or(0.0, |s| s.direction.z.max(0.0) as f64 / s.pdf);
+            sum += value;
+            sum_sq += value * value;
+        }
+        let mean = sum / n as f64;
+        let variance = sum_sq / n as f64 - mean * mean;
+        let z = (mean - exact) / (variance / n as f64).sqrt();
+        assert!(
+            z.abs() < 4.0,
+            "sampler {seed}: {mean} vs exact {exact} (z {z:.1})"
+        );
+        variances.push(variance);
+    }
+    let ratio = variances[1] / variances[0];
+    println!("area-sampling variance / solid-angle-sampling variance = {ratio:.1}");
+    assert!(
+        ratio > 3.0,
+        "solid-angle sampling should win clearly, ratio {ratio}"
+    );
 }

@@ -2,6 +2,7 @@
 //! including Mitsuba's rectangles (area-weighted triangle choice, uniform points on the
 //! triangle). Emission is one-sided, toward the surface normal, as in Mitsuba.
 
+use super::spherical_rectangle::Rectangle;
 use crate::distribution::Distribution1D;
 use crate::geometry::{Ray, Sphere, Triangle};
 use glam::Vec3;
@@ -17,6 +18,8 @@ pub enum AreaShape {
         /// Whether the shape's normals are flipped.
         flipped: bool,
     },
+    /// A rectangle, sampled uniformly in the solid angle it subtends.
+    Rectangle(Rectangle),
     /// Triangles, each emitting toward the side of its (possibly flipped) winding normal.
     Triangles {
         /// World-space triangles, already wound so that the emitting side is front.
@@ -86,6 +89,7 @@ impl AreaLight {
     pub fn power(&self) -> f64 {
         let area = match &self.shape {
             AreaShape::Sphere { sphere, .. } => 4.0 * PI * (sphere.radius as f64).powi(2),
+            AreaShape::Rectangle(rectangle) => rectangle.area(),
             AreaShape::Triangles { area, .. } => *area,
         };
         PI * super::luminance(self.radiance) as f64 * area
@@ -118,6 +122,10 @@ impl AreaLight {
                     direction,
                     pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
                 })
+            }
+            AreaShape::Rectangle(rectangle) => {
+                let (direction, pdf) = rectangle.sample(point, u)?;
+                Some(AreaSample { direction, pdf })
             }
             AreaShape::Triangles {
                 triangles,
@@ -165,6 +173,13 @@ impl AreaLight {
                     0.0
                 }
             }
+            AreaShape::Rectangle(rectangle) => {
+                if rectangle.intersect(&Ray::new(point, direction)).is_some() {
+                    1.0 / rectangle.solid_angle(point)
+                } else {
+                    0.0
+                }
+            }
             AreaShape::Triangles {
                 triangles, area, ..
             } => {
@@ -189,6 +204,9 @@ impl AreaLight {
                 let t = sphere.intersect(ray, ray.t_max)?;
                 let n = (ray.at(t) - sphere.center).normalize();
                 Some((t, if *flipped { -n } else { n }))
+            }
+            AreaShape::Rectangle(rectangle) => {
+                rectangle.intersect(ray).map(|t| (t, rectangle.normal))
             }
             AreaShape::Triangles { triangles, .. } => triangles
                 .iter()

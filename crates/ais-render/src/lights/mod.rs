@@ -3,9 +3,11 @@
 
 mod area;
 mod environment;
+mod spherical_rectangle;
 
 pub use area::{AreaLight, AreaSample, AreaShape};
 pub use environment::{luminance, Environment, EnvironmentMap};
+pub use spherical_rectangle::Rectangle;
 
 use crate::distribution::Distribution1D;
 use crate::geometry::Ray;
