@@ -1,9 +1,10 @@
 //! The `ais` command.
 
 use ais_render::default_scene::default_world;
+use ais_render::gather::{AisMode, GatherSettings};
 use ais_render::image_io::RgbImage;
 use ais_render::image_io::{write_exr, write_png};
-use ais_render::integrator::{AisMode, GatherSettings, Integrator};
+use ais_render::integrator::Integrator;
 use ais_render::proposal::Strategy;
 use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;

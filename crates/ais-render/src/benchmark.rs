@@ -3,8 +3,8 @@
 //! Each figure is the median of several runs measured in one process.
 
 use crate::default_scene::default_world;
+use crate::geometry::basis;
 use crate::geometry::{spawn_ray, Geometry};
-use crate::integrator::basis;
 use crate::world::World;
 use ais::rng::Pcg32;
 use rayon::prelude::*;

@@ -1,13 +1,11 @@
-//! Integrators available before lighting lands: shading normals and ambient occlusion.
-//! They exist to verify geometry; the AIS gather integrator comes with the lighting issue.
+//! What a camera sample computes: the AIS gather (see [`crate::gather`]), or shading
+//! normals and ambient occlusion for checking geometry; and the per-thread state they share.
 
-use crate::bsdf::ShadingFrame;
-use crate::geometry::{spawn_ray, Ray};
-use crate::lights::luminance;
-use crate::proposal::{GatherPoint, Strategy};
+use crate::gather::{gather, GatherSettings};
+use crate::geometry::{basis, spawn_ray, Ray};
 use crate::world::World;
 use ais::rng::Pcg32;
-use ais::{rating, Batch, BatchConfig, Decision, MapConfig, MapStart, Mode, Stopping};
+use ais::Batch;
 use glam::Vec3;
 
 /// Rays traced, by kind.
@@ -29,94 +27,6 @@ impl RayCounts {
     /// All rays.
     pub fn total(&self) -> u64 {
         self.closest_hit + self.occlusion
-    }
-}
-
-/// AIS setting of the gather.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum AisMode {
-    /// No affinity map: every in-support candidate is traced.
-    Off,
-    /// The talk's aggressive map.
-    Aggressive,
-    /// The talk's conservative map (shadow-edge resets).
-    Conservative,
-}
-
-impl AisMode {
-    /// Parses a command-line or XML name.
-    pub fn parse(name: &str) -> Option<AisMode> {
-        match name {
-            "off" => Some(AisMode::Off),
-            "aggressive" => Some(AisMode::Aggressive),
-            "conservative" => Some(AisMode::Conservative),
-            _ => None,
-        }
-    }
-}
-
-/// Settings of the multi-ray gather integrator.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct GatherSettings {
-    /// The proposal sampler.
-    pub strategy: Strategy,
-    /// AIS off, aggressive or conservative.
-    pub ais: AisMode,
-    /// Rays per gather (n).
-    pub rays: u32,
-    /// The map's tol (a_min = 1 / (tol h²)).
-    pub tol: f32,
-    /// The map's height in texels.
-    pub map_height: u32,
-    /// Halton (the talk's) or independent random candidates.
-    pub placement: ais::Placement,
-}
-
-impl Default for GatherSettings {
-    fn default() -> Self {
-        let map = MapConfig::default();
-        GatherSettings {
-            strategy: Strategy::Mis,
-            // Measured: per-batch AIS with Halton placement loses to AIS off in every room
-            // and scene tried so far (BENCHMARKS.md), so the renderer starts with it off.
-            ais: AisMode::Off,
-            rays: 16,
-            tol: map.tol,
-            map_height: map.height,
-            placement: ais::Placement::Halton,
-        }
-    }
-}
-
-impl GatherSettings {
-    /// The batch configuration. Every mode uses the candidate-budget stopping rule, which is
-    /// exactly unbiased with Halton placement even when candidates fall outside the support.
-    pub fn batch_config(&self) -> BatchConfig {
-        let base = BatchConfig {
-            stopping: Stopping::CandidateBudget,
-            placement: self.placement,
-            ..BatchConfig::default()
-        };
-        match self.ais {
-            AisMode::Off => BatchConfig {
-                affinity: None,
-                learning: ais::Learning::Off,
-                ..base
-            },
-            AisMode::Aggressive | AisMode::Conservative => BatchConfig {
-                affinity: Some(MapConfig {
-                    height: self.map_height,
-                    tol: self.tol,
-                    mode: if self.ais == AisMode::Aggressive {
-                        Mode::Aggressive
-                    } else {
-                        Mode::Conservative
-                    },
-                    ..MapConfig::default()
-                }),
-                ..base
-            },
-        }
     }
 }
 
@@ -147,17 +57,6 @@ pub enum Integrator {
         /// Occlusion distance (world units).
         distance: f32,
     },
-}
-
-/// An orthonormal basis around `n` (Duff et al.'s branchless construction).
-pub fn basis(n: Vec3) -> (Vec3, Vec3) {
-    let sign = 1.0f32.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    (
-        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
-        Vec3::new(b, sign + n.y * n.y * a, -n.y),
-    )
 }
 
 impl Integrator {
@@ -209,106 +108,6 @@ impl Integrator {
                 }
                 [visible as f32 / *rays as f32; 3]
             }
-        }
-    }
-}
-
-/// The gather: emitted radiance at the first hit plus `n` rays of direct light through the
-/// AIS batch driver.
-fn gather(
-    world: &World,
-    settings: &GatherSettings,
-    ray: &Ray,
-    rng: &mut Pcg32,
-    context: &mut SampleContext,
-) -> Vec3 {
-    context.counts.closest_hit += 1;
-    let Some(hit) = world.geometry.intersect(ray) else {
-        return world.lights.background(ray.direction);
-    };
-    let emitted = world
-        .lights
-        .emitted(hit.shape, hit.geometric_normal, ray.direction);
-    if world.lights.is_empty() {
-        return emitted;
-    }
-    let wo = -ray.direction;
-    let material = &world.materials[hit.shape as usize];
-    let frame = ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo);
-    let at = GatherPoint {
-        point: hit.point,
-        frame,
-        wo,
-        material,
-        lights: &world.lights,
-    };
-    let SampleContext {
-        counts,
-        batch,
-        ais_timer: timer,
-    } = context;
-    let batch = batch.get_or_insert_with(|| {
-        Batch::new(settings.batch_config()).expect("valid gather configuration")
-    });
-    let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
-    timer.start_gather();
-    batch.begin(settings.rays, seed, MapStart::Empty);
-    while let Some(candidate) = batch.next_candidate() {
-        let Some((direction, pdf)) = settings
-            .strategy
-            .sample(&at, candidate.u)
-            .filter(|s| s.1 > 0.0)
-        else {
-            timer.decided(frame.normal, false);
-            batch.decide(frame.normal, false);
-            continue;
-        };
-        let in_support = material.in_support(&frame, wo, direction);
-        timer.decided(direction, in_support);
-        if let Decision::Trace { .. } = batch.decide(direction, in_support) {
-            let mut leaving = spawn_ray(hit.point, frame.geometric, direction);
-            let (unoccluded, distance) = world.lights.unoccluded(&leaving);
-            // The emitter's own surface is in the BVH: stop just short of it. A ray whose
-            // unoccluded radiance is zero brings zero whatever blocks it: no need to trace.
-            let actual = if unoccluded == Vec3::ZERO {
-                Vec3::ZERO
-            } else {
-                leaving.t_max = distance * (1.0 - 1e-4);
-                counts.occlusion += 1;
-                if world.geometry.occluded(&leaving) {
-                    Vec3::ZERO
-                } else {
-                    unoccluded
-                }
-            };
-            let value = material.eval(&frame, wo, direction) * actual / pdf as f32;
-            let rating = rating(luminance(actual), luminance(unoccluded));
-            timer.recorded(value.to_array(), rating);
-            batch.record(value.to_array(), rating);
-        }
-    }
-    let estimate = batch.finish();
-    timer.end_gather(batch.config(), settings.rays, seed);
-    emitted + Vec3::from(estimate.value)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn basis_is_orthonormal() {
-        let mut rng = Pcg32::new(4, 4);
-        for _ in 0..1000 {
-            let n = Vec3::new(
-                rng.next_f32() - 0.5,
-                rng.next_f32() - 0.5,
-                rng.next_f32() - 0.5,
-            )
-            .normalize();
-            let (t, b) = basis(n);
-            assert!(t.dot(n).abs() < 1e-5 && b.dot(n).abs() < 1e-5 && t.dot(b).abs() < 1e-5);
-            assert!((t.length() - 1.0).abs() < 1e-5 && (b.length() - 1.0).abs() < 1e-5);
         }
     }
 }

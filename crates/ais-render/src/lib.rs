@@ -14,6 +14,7 @@ pub mod default_scene;
 pub mod distribution;
 pub mod error;
 pub mod film;
+pub mod gather;
 pub mod geometry;
 pub mod image_io;
 pub mod integrator;

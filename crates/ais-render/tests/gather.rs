@@ -4,7 +4,8 @@
 
 mod common;
 
-use ais_render::integrator::{AisMode, GatherSettings, Integrator};
+use ais_render::gather::{AisMode, GatherSettings};
+use ais_render::integrator::Integrator;
 use ais_render::proposal::Strategy;
 use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;

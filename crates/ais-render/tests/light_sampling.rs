@@ -311,7 +311,7 @@ fn views() -> Vec<(ShadingFrame, Vec3)> {
     [30f32, 75.0]
         .iter()
         .map(|&degrees| {
-            let (t, _) = ais_render::integrator::basis(normal);
+            let (t, _) = ais_render::geometry::basis(normal);
             let wo =
                 (normal * degrees.to_radians().cos() + t * degrees.to_radians().sin()).normalize();
             (

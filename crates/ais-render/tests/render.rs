@@ -28,8 +28,8 @@ fn images_are_bit_identical_at_one_and_two_threads() {
         rays: 4,
         distance: 1.0,
     };
-    let gather = Integrator::Gather(ais_render::integrator::GatherSettings {
-        ais: ais_render::integrator::AisMode::Aggressive,
+    let gather = Integrator::Gather(ais_render::gather::GatherSettings {
+        ais: ais_render::gather::AisMode::Aggressive,
         ..Default::default()
     });
     let render_with = |threads: usize, integrator: Integrator| {

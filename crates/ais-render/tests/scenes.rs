@@ -2,7 +2,8 @@
 
 mod common;
 
-use ais_render::integrator::{GatherSettings, Integrator};
+use ais_render::gather::GatherSettings;
+use ais_render::integrator::Integrator;
 use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;

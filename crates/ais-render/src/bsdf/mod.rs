@@ -6,7 +6,7 @@ mod microfacet;
 
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Ggx};
 
-use crate::integrator::basis;
+use crate::geometry::basis;
 use crate::scene::{Plugin, Property};
 use glam::Vec3;
 use std::f32::consts::PI;

@@ -1,9 +1,11 @@
 //! Scene geometry: triangle meshes and spheres in an obvhs CWBVH, with closest-hit and
 //! occlusion queries.
 
+mod basis;
 mod primitive;
 mod ray;
 
+pub use basis::basis;
 pub use primitive::{Primitive, Sphere, Triangle};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
 

@@ -113,7 +113,7 @@ impl AreaLight {
                 let cos_theta = 1.0 - u[0] as f64 * (1.0 - cos_max);
                 let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
                 let phi = 2.0 * PI * u[1] as f64;
-                let (t, b) = crate::integrator::basis(axis);
+                let (t, b) = crate::geometry::basis(axis);
                 let direction = (t * (sin_theta * phi.cos()) as f32
                     + b * (sin_theta * phi.sin()) as f32
                     + axis * cos_theta as f32)
