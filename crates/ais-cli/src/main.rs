@@ -96,7 +96,7 @@ struct RenderArgs {
     /// Override the film size, e.g. 640x360.
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,
-    /// What to render (default: the scene's <integrator type="gather">, else gather).
+    /// What to render (default: the scene's `<integrator type="gather">`, else gather).
     #[arg(long, value_enum)]
     integrator: Option<IntegratorChoice>,
     /// Gather proposal: uniform, bsdf, light or mis.

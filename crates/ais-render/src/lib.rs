@@ -5,6 +5,8 @@
 //! EXR plus a tone-mapped PNG preview. Rendering is tiled over rayon with per-pixel seeds,
 //! so images do not depend on the thread count.
 
+#![warn(missing_docs)]
+
 pub mod ais_timer;
 pub mod atomic_write;
 pub mod benchmark;

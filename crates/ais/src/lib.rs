@@ -22,6 +22,8 @@
 //! - [`analytic`]: analytic gather scenes with exact integrals, for tests, studies and hosts
 //!   that want to validate their integration.
 
+#![warn(missing_docs)]
+
 pub mod affinity_map;
 pub mod analytic;
 pub mod batch;
