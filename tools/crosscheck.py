@@ -54,6 +54,9 @@ def main():
     text, count = re.subn(r"<integrator\b[^>]*/>|<integrator\b[^>]*[^/]>.*?</integrator>", direct, text, count=1, flags=re.S)
     if count == 0:
         text = re.sub(r"(<scene\b[^>]*>)", r"\1" + direct, text, count=1)
+    # ais reconstructs pixels with a box filter; Mitsuba's hdrfilm defaults to a Gaussian.
+    if "<rfilter" not in text:
+        text = re.sub(r"(<film\b[^>]*>)", r'\1<rfilter type="box"/>', text, count=1)
     with tempfile.TemporaryDirectory() as work:
         mitsuba_scene = os.path.join(scene_dir, f".crosscheck-{os.getpid()}.xml")
         with open(mitsuba_scene, "w") as f:
