@@ -3,7 +3,7 @@
 //! Each figure is the median of several runs measured in one process.
 
 use crate::default_scene::default_world;
-use crate::geometry::basis;
+use crate::geometry::{basis, cosine_hemisphere};
 use crate::geometry::{spawn_ray, Geometry};
 use crate::world::World;
 use ais::rng::Pcg32;
@@ -116,12 +116,8 @@ pub fn run(
                         let n = hit.geometric_normal;
                         let (t, b) = basis(n);
                         for _ in 0..gather_rays {
-                            let (u1, u2) = (rng.next_f32(), rng.next_f32());
-                            let r = u1.sqrt();
-                            let phi = std::f32::consts::TAU * u2;
-                            let d =
-                                (t * (r * phi.cos()) + b * (r * phi.sin()) + n * (1.0 - u1).sqrt())
-                                    .normalize();
+                            let l = cosine_hemisphere([rng.next_f32(), rng.next_f32()]);
+                            let d = (t * l.x + b * l.y + n * l.z).normalize();
                             let ray = spawn_ray(hit.point, n, d);
                             if closest {
                                 std::hint::black_box(geometry.intersect(&ray));

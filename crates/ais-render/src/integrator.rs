@@ -2,11 +2,10 @@
 //! normals and ambient occlusion for checking geometry; and the per-thread state they share.
 
 use crate::gather::{gather, GatherSettings};
-use crate::geometry::{basis, spawn_ray, Ray};
+use crate::geometry::{basis, cosine_hemisphere, spawn_ray, Ray};
 use crate::world::World;
 use ais::rng::Pcg32;
 use ais::Batch;
-use glam::Vec3;
 
 /// Rays traced, by kind.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -91,10 +90,7 @@ impl Integrator {
                 let (t, b) = basis(n);
                 let mut visible = 0u32;
                 for _ in 0..*rays {
-                    let (u1, u2) = (rng.next_f32(), rng.next_f32());
-                    let r = u1.sqrt();
-                    let phi = std::f32::consts::TAU * u2;
-                    let local = Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u1).max(0.0).sqrt());
+                    let local = cosine_hemisphere([rng.next_f32(), rng.next_f32()]);
                     let direction = (t * local.x + b * local.y + n * local.z).normalize();
                     if direction.dot(ng) <= 0.0 {
                         continue; // below the geometric surface: blocked by it

@@ -2,6 +2,7 @@
 //! a direction and the density of the whole strategy at that direction.
 
 use crate::bsdf::{Material, ShadingFrame};
+use crate::geometry::uniform_sphere;
 use crate::lights::Lights;
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -58,13 +59,6 @@ pub struct GatherPoint<'a> {
     pub material: &'a Material,
     /// The scene's emitters.
     pub lights: &'a Lights,
-}
-
-fn uniform_sphere(u: [f32; 2]) -> Vec3 {
-    let z = 1.0 - 2.0 * u[0];
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = std::f32::consts::TAU * u[1];
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
 }
 
 impl Strategy {

@@ -6,7 +6,7 @@ mod microfacet;
 
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Ggx};
 
-use crate::geometry::basis;
+use crate::geometry::{basis, cosine_hemisphere};
 use crate::scene::{Plugin, Property};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -332,14 +332,9 @@ impl Material {
     /// A direction drawn from the BSDF for viewing direction `wo`, and its density.
     pub fn sample(&self, frame: &ShadingFrame, wo: Vec3, u: [f32; 2]) -> (Vec3, f64) {
         let o = frame.to_local(wo);
-        let cosine = |u: [f32; 2]| {
-            let r = u[0].sqrt();
-            let phi = 2.0 * PI * u[1];
-            Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u[0]).max(0.0).sqrt())
-        };
         let reflect = |h: Vec3| 2.0 * o.dot(h) * h - o;
         let local = match self.scattering {
-            Scattering::Diffuse { .. } => cosine(u),
+            Scattering::Diffuse { .. } => cosine_hemisphere(u),
             Scattering::RoughConductor { ggx, .. } => {
                 if o.z <= 0.0 {
                     return (frame.normal, 0.0);
@@ -356,7 +351,7 @@ impl Material {
                 if u[0] < p && o.z > 0.0 {
                     reflect(ggx.sample_visible(o, [u[0] / p, u[1]]))
                 } else {
-                    cosine([((u[0] - p) / (1.0 - p)).clamp(0.0, 1.0 - 1e-7), u[1]])
+                    cosine_hemisphere([((u[0] - p) / (1.0 - p)).clamp(0.0, 1.0 - 1e-7), u[1]])
                 }
             }
         };

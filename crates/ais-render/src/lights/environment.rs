@@ -7,6 +7,7 @@
 //! is piecewise constant over texels, weighted by luminance · sin θ.
 
 use crate::distribution::Distribution2D;
+use crate::geometry::uniform_sphere;
 use crate::image_io::RgbImage;
 use glam::{DMat3, DVec3, Vec3};
 use std::f64::consts::PI;
@@ -96,15 +97,7 @@ impl Environment {
     /// A direction drawn from `u` and its density in solid angle.
     pub fn sample(&self, u: [f32; 2]) -> (Vec3, f64) {
         match self {
-            Environment::Constant(_) => {
-                let z = 1.0 - 2.0 * u[0] as f64;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                let phi = 2.0 * PI * u[1] as f64;
-                (
-                    DVec3::new(r * phi.cos(), r * phi.sin(), z).as_vec3(),
-                    1.0 / (4.0 * PI),
-                )
-            }
+            Environment::Constant(_) => (uniform_sphere(u), 1.0 / (4.0 * PI)),
             Environment::Map(map) => {
                 let (uv, pdf_uv) = map.distribution.sample([u[0] as f64, u[1] as f64]);
                 let (direction, sin_theta) = map.direction(uv);
