@@ -1,84 +1,331 @@
 #!/usr/bin/env python3
-"""Preliminary cross-check of ais against Mitsuba 3 on the same scene file.
+"""Cross-check ais against Mitsuba 3 on the same scene files.
 
-    python3 -m venv .venv && .venv/bin/pip install mitsuba numpy
+    python3 tools/crosscheck.py --setup            # makes .venv with mitsuba and numpy
     cargo build --release -p ais-cli
-    .venv/bin/python tools/crosscheck.py scenes/open.xml [--spp 64] [--size 160x90]
+    .venv/bin/python tools/crosscheck.py scenes/occluded.xml [--spp 512] [--size 64x36]
+    .venv/bin/python tools/crosscheck.py --suite   # every scene the test suite checks
 
-Renders the scene with Mitsuba's `direct` integrator (scalar_rgb, emitter and BSDF samples
-set by --mitsuba-samples) and with `ais render` (gather, MIS, AIS off), each at the same
-resolution and samples per pixel, and prints per-channel mean ratios (ais / Mitsuba) and the
-relative MSE between the two images. Mitsuba runs in a child process per scene, since
-loading a second scene in one process has been seen to deadlock. The scene's own
-<integrator> is replaced by Mitsuba's direct integrator for the Mitsuba render.
+Each scene is rendered by Mitsuba's `direct` integrator (scalar_rgb; `--mitsuba-samples`
+emitter and BSDF samples per camera sample; a box pixel filter like ours) and by
+`ais render` (gather, MIS, once per `--modes` entry: AIS off and per-batch AIS by default),
+at the same resolution. Each renderer runs `--runs` times with independent seeds, and the
+spread of those runs gives a per-pixel standard error (SE) for both images. Reported per
+scene and ais mode:
 
-This is the first step of issue 5: no standard-error maps or block tests yet.
+- the per-channel ratio of image means, ais / Mitsuba (threshold: within 1%);
+- relMSE = mean((ais - mitsuba)^2 / (mitsuba^2 + 0.01)) over pixels and channels
+  (threshold 2e-3), and its noise floor, the part that the SEs alone explain;
+- the largest deviation of an 8x8 pixel block mean, in SEs (threshold 5);
+- images in --out: both renders (EXR), the per-channel difference in SEs (EXR), and a
+  false-colour PNG of that difference (blue: ais darker, red: ais brighter, saturating at
+  5 SE).
+
+Exit status 1 when a threshold is exceeded, 2 for a setup problem (no Mitsuba, no ais
+binary, a scene that does not load). Mitsuba runs in a child process per scene, since
+loading a second scene in one process has been seen to deadlock.
 """
 import argparse
+import glob
+import json
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
+import time
 
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+MITSUBA_VERSION = "3.9.1"
+MEAN_TOLERANCE = 0.01
+RELMSE_LIMIT = 2e-3
+RELMSE_EPSILON = 1e-2
+BLOCK = 8
+BLOCK_LIMIT = 5.0
+
+# Renders one scene `runs` times with seeds 0..runs-1 and saves the stack (runs, H, W, 3).
 MITSUBA_CHILD = r"""
 import sys, numpy as np, mitsuba as mi
 mi.set_variant('scalar_rgb')
-scene = mi.load_file(sys.argv[1], res_x=int(sys.argv[3]), res_y=int(sys.argv[4]), spp=int(sys.argv[5]))
-np.save(sys.argv[2], np.array(mi.render(scene)))
+scene = mi.load_file(sys.argv[1])
+runs, spp = int(sys.argv[3]), int(sys.argv[4])
+np.save(sys.argv[2], np.stack([np.array(mi.render(scene, seed=k, spp=spp))[..., :3]
+                               for k in range(runs)]))
 """
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("scene")
-    parser.add_argument("--spp", type=int, default=64)
-    parser.add_argument("--size", default="160x90")
-    parser.add_argument("--rays", type=int, default=16, help="gather rays per camera sample (ais)")
-    parser.add_argument("--mitsuba-samples", type=int, default=8, help="emitter and BSDF samples (Mitsuba direct)")
-    parser.add_argument("--ais", default=os.path.join("target", "release", "ais"), help="path of the ais binary")
-    args = parser.parse_args()
-    try:
-        import numpy as np
-        import mitsuba as mi
-    except ImportError as e:
-        sys.exit(f"error: {e}; install with `pip install mitsuba numpy` (see the docstring)")
-    width, height = (int(v) for v in args.size.lower().split("x"))
-    if not os.path.exists(args.ais):
-        sys.exit(f"error: {args.ais} not found; run `cargo build --release -p ais-cli` first")
-    scene_dir = os.path.dirname(os.path.abspath(args.scene))
-    with open(args.scene) as f:
-        text = f.read()
-    direct = (f'<integrator type="direct"><integer name="emitter_samples" value="{args.mitsuba_samples}"/>'
-              f'<integer name="bsdf_samples" value="{args.mitsuba_samples}"/></integrator>')
-    text, count = re.subn(r"<integrator\b[^>]*/>|<integrator\b[^>]*[^/]>.*?</integrator>", direct, text, count=1, flags=re.S)
+def fail_setup(message):
+    print(f"crosscheck: error: {message}", file=sys.stderr)
+    sys.exit(2)
+
+
+def setup_venv(venv):
+    """Creates `venv` with Mitsuba and numpy (pinned Mitsuba) and returns its python."""
+    python = os.path.join(venv, "bin", "python")
+    probe = [python, "-c", f"import mitsuba, numpy; assert mitsuba.__version__ == '{MITSUBA_VERSION}'"]
+    if os.path.exists(python) and subprocess.run(probe, capture_output=True).returncode == 0:
+        return python
+    print(f"crosscheck: installing mitsuba=={MITSUBA_VERSION} and numpy into {venv}", file=sys.stderr)
+    steps = [[sys.executable, "-m", "venv", venv],
+             [python, "-m", "pip", "install", "--quiet", "--disable-pip-version-check",
+              f"mitsuba=={MITSUBA_VERSION}", "numpy"]]
+    for step in steps:
+        done = subprocess.run(step, capture_output=True, text=True)
+        if done.returncode != 0:
+            fail_setup(f"`{' '.join(step)}` failed:\n{done.stdout}{done.stderr}")
+    if subprocess.run(probe, capture_output=True).returncode != 0:
+        fail_setup(f"mitsuba {MITSUBA_VERSION} does not import in {venv}")
+    return python
+
+
+def mitsuba_scene_text(text, width, height, samples):
+    """The scene for Mitsuba: its `direct` integrator, our film size and a box filter."""
+    direct = (f'<integrator type="direct"><integer name="emitter_samples" value="{samples}"/>'
+              f'<integer name="bsdf_samples" value="{samples}"/></integrator>')
+    text, count = re.subn(r"<integrator\b[^>]*/>|<integrator\b[^>]*[^/]>.*?</integrator>",
+                          direct, text, count=1, flags=re.S)
     if count == 0:
         text = re.sub(r"(<scene\b[^>]*>)", r"\1" + direct, text, count=1)
-    # ais reconstructs pixels with a box filter; Mitsuba's hdrfilm defaults to a Gaussian.
-    if "<rfilter" not in text:
-        text = re.sub(r"(<film\b[^>]*>)", r'\1<rfilter type="box"/>', text, count=1)
-    with tempfile.TemporaryDirectory() as work:
-        mitsuba_scene = os.path.join(scene_dir, f".crosscheck-{os.getpid()}.xml")
-        with open(mitsuba_scene, "w") as f:
-            f.write(text)
-        try:
-            reference = os.path.join(work, "mitsuba.npy")
-            subprocess.run([sys.executable, "-c", MITSUBA_CHILD, mitsuba_scene, reference,
-                            str(width), str(height), str(args.spp)], check=True)
-        finally:
-            os.remove(mitsuba_scene)
-        ours_path = os.path.join(work, "ais.exr")
-        subprocess.run([args.ais, "render", args.scene, "--resolution", f"{width}x{height}",
-                        "--spp", str(args.spp), "--rays", str(args.rays), "--strategy", "mis",
-                        "--ais", "off", "--quiet", "--no-preview", "-o", ours_path],
-                       check=True, stdout=subprocess.DEVNULL)
-        mi.set_variant("scalar_rgb")
-        ours = np.array(mi.Bitmap(ours_path))[..., :3]
-        theirs = np.load(reference)[..., :3]
-    ratio = ours.reshape(-1, 3).mean(0) / theirs.reshape(-1, 3).mean(0)
-    rel_mse = float(((ours - theirs) ** 2 / (theirs ** 2 + 1e-2)).mean())
-    print(f"{args.scene}: mean ratio ais/Mitsuba R {ratio[0]:.4f} G {ratio[1]:.4f} B {ratio[2]:.4f}; "
-          f"relMSE {rel_mse:.2e} ({args.spp} spp, {width}x{height})")
+
+    def film(match):
+        body = match.group(0)
+        for name, value in (("width", width), ("height", height)):
+            body, found = re.subn(rf'(<integer\s+name="{name}"\s+value=")[^"]*(")',
+                                  rf"\g<1>{value}\g<2>", body)
+            if not found:
+                body = re.sub(r"(<film\b[^>]*>)", rf'\1<integer name="{name}" value="{value}"/>', body)
+        # ais reconstructs pixels with a box filter; Mitsuba's hdrfilm defaults to a Gaussian.
+        body = re.sub(r"<rfilter\b[^>]*/>|<rfilter\b.*?</rfilter>", "", body, flags=re.S)
+        return re.sub(r"(<film\b[^>]*>)", r'\1<rfilter type="box"/>', body, count=1)
+
+    text, films = re.subn(r"<film\b.*?</film>", film, text, count=1, flags=re.S)
+    if films == 0:
+        text = re.sub(r"(<sensor\b[^>]*>)", rf'\1<film type="hdrfilm"><integer name="width" value="{width}"/>'
+                      rf'<integer name="height" value="{height}"/><rfilter type="box"/></film>', text, count=1)
+    return text
+
+
+def render_mitsuba(scene, width, height, runs, spp, samples, work):
+    with open(scene) as f:
+        text = mitsuba_scene_text(f.read(), width, height, samples)
+    # Beside the original, so that relative asset paths resolve.
+    copy = os.path.join(os.path.dirname(os.path.abspath(scene)), f".crosscheck-{os.getpid()}.xml")
+    with open(copy, "w") as f:
+        f.write(text)
+    out = os.path.join(work, "mitsuba.npy")
+    try:
+        done = subprocess.run([sys.executable, "-c", MITSUBA_CHILD, copy, out, str(runs), str(spp)],
+                              capture_output=True, text=True)
+    finally:
+        os.remove(copy)
+    if done.returncode != 0:
+        fail_setup(f"Mitsuba could not render {scene}:\n{done.stderr.strip()}")
+    import numpy as np
+    return np.load(out).astype(np.float64)
+
+
+def render_ais(binary, scene, width, height, runs, spp, rays, mode, work):
+    import mitsuba as mi
+    import numpy as np
+    images = []
+    for k in range(runs):
+        out = os.path.join(work, f"ais-{mode}-{k}.exr")
+        command = [binary, "render", scene, "--resolution", f"{width}x{height}", "--spp", str(spp),
+                   "--integrator", "gather", "--strategy", "mis", "--rays", str(rays), "--ais", mode,
+                   "--seed", str(1000 + k), "--quiet", "--no-preview", "-o", out]
+        done = subprocess.run(command, capture_output=True, text=True)
+        if done.returncode != 0:
+            fail_setup(f"`{' '.join(command)}` failed:\n{done.stderr.strip()}")
+        images.append(np.array(mi.Bitmap(out))[..., :3])
+    return np.stack(images).astype(np.float64)
+
+
+def statistics(ours, theirs):
+    """Compares two stacks of independent runs (runs, H, W, 3)."""
+    import numpy as np
+    runs = ours.shape[0]
+    mean_ours, mean_theirs = ours.mean(0), theirs.mean(0)
+    var_ours = ours.var(0, ddof=1) / runs
+    var_theirs = theirs.var(0, ddof=1) / theirs.shape[0]
+    difference = mean_ours - mean_theirs
+    variance = var_ours + var_theirs
+    # Pixels that both renderers compute exactly (a constant background, black) have no
+    # spread; a float-rounding floor keeps them from dividing by zero.
+    floor = (1e-6 * (np.abs(mean_theirs) + 1e-6)) ** 2
+    z = difference / np.sqrt(variance + floor)
+    denominator = mean_theirs ** 2 + RELMSE_EPSILON
+    rel_mse = float((difference ** 2 / denominator).mean())
+    noise_floor = float((variance / denominator).mean())
+    ratio = mean_ours.reshape(-1, 3).mean(0) / np.maximum(mean_theirs.reshape(-1, 3).mean(0), 1e-30)
+    height, width = difference.shape[:2]
+    worst = (0.0, None)
+    for y in range(0, height, BLOCK):
+        for x in range(0, width, BLOCK):
+            d = difference[y:y + BLOCK, x:x + BLOCK].reshape(-1, 3)
+            v = variance[y:y + BLOCK, x:x + BLOCK].reshape(-1, 3)
+            f = floor[y:y + BLOCK, x:x + BLOCK].reshape(-1, 3)
+            block_z = d.mean(0) / np.sqrt((v + f).sum(0) / d.shape[0] ** 2)
+            channel = int(np.abs(block_z).argmax())
+            if abs(block_z[channel]) > abs(worst[0]):
+                worst = (float(block_z[channel]), (x, y, "RGB"[channel]))
+    # The z of the channel sum, for the false-colour image.
+    sums_ours, sums_theirs = ours.sum(-1), theirs.sum(-1)
+    sum_variance = sums_ours.var(0, ddof=1) / runs + sums_theirs.var(0, ddof=1) / theirs.shape[0]
+    z_sum = (sums_ours.mean(0) - sums_theirs.mean(0)) / np.sqrt(sum_variance + floor.sum(-1))
+    return {
+        "mean_ratio": [float(r) for r in ratio],
+        "rel_mse": rel_mse,
+        "rel_mse_noise_floor": noise_floor,
+        "worst_block_se": worst[0],
+        "worst_block": worst[1],
+        "z": z,
+        "z_sum": z_sum,
+        "mean_ours": mean_ours,
+        "mean_theirs": mean_theirs,
+    }
+
+
+def false_colour(z):
+    """Blue (negative) - white - red (positive), saturating at the block limit."""
+    import numpy as np
+    t = np.clip(z / BLOCK_LIMIT, -1.0, 1.0)[..., None]
+    white = np.ones(3)
+    red, blue = np.array([0.85, 0.1, 0.1]), np.array([0.1, 0.25, 0.85])
+    rgb = np.where(t > 0, white + t * (red - white), white - t * (blue - white))
+    return (rgb * 255.0 + 0.5).astype(np.uint8)
+
+
+def save(path, array):
+    import mitsuba as mi
+    import numpy as np
+    array = np.ascontiguousarray(array)
+    temporary = path + ".part" + os.path.splitext(path)[1]
+    mi.Bitmap(array.astype(np.float32) if array.dtype != np.uint8 else array).write(temporary)
+    os.replace(temporary, path)
+
+
+def check(stats):
+    """The threshold failures of one comparison, as sentences."""
+    failures = []
+    for channel, ratio in zip("RGB", stats["mean_ratio"]):
+        if not abs(ratio - 1.0) <= MEAN_TOLERANCE:
+            failures.append(f"{channel} mean ratio {ratio:.4f} is off by more than {MEAN_TOLERANCE:.0%}")
+    if not stats["rel_mse"] < RELMSE_LIMIT:
+        failures.append(f"relMSE {stats['rel_mse']:.2e} is not below {RELMSE_LIMIT:.0e}")
+    if not abs(stats["worst_block_se"]) <= BLOCK_LIMIT:
+        x, y, channel = stats["worst_block"]
+        failures.append(f"the 8x8 block at pixel ({x}, {y}) deviates by {stats['worst_block_se']:+.1f} SE "
+                        f"in {channel}")
+    return failures
+
+
+def suite_scenes():
+    scenes = sorted(glob.glob(os.path.join(ROOT, "scenes", "*.xml")))
+    scenes += sorted(glob.glob(os.path.join(ROOT, "scenes", "crosscheck", "*.xml")))
+    return scenes
+
+
+def ensure_assets():
+    if not os.path.exists(os.path.join(ROOT, "scenes", "assets", "sky.hdr")):
+        subprocess.run([sys.executable, os.path.join(ROOT, "scenes", "make_assets.py")], check=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    parser.add_argument("scenes", nargs="*", help="Mitsuba XML scene files")
+    parser.add_argument("--suite", action="store_true",
+                        help="check scenes/*.xml and scenes/crosscheck/*.xml against the thresholds")
+    parser.add_argument("--setup", action="store_true",
+                        help=f"create --venv with mitsuba {MITSUBA_VERSION} and numpy, then run in it")
+    parser.add_argument("--venv", default=os.path.join(ROOT, ".venv"))
+    parser.add_argument("--size", default="64x36", help="film size for both renderers")
+    parser.add_argument("--spp", type=int, default=512, help="camera samples per pixel, over all runs")
+    parser.add_argument("--runs", type=int, default=8, help="independent runs per renderer (for the SEs)")
+    parser.add_argument("--rays", type=int, default=16, help="ais gather rays per camera sample")
+    parser.add_argument("--mitsuba-samples", type=int, default=8,
+                        help="Mitsuba direct: emitter and BSDF samples per camera sample")
+    parser.add_argument("--modes", default="off,aggressive", help="ais --ais modes to check")
+    parser.add_argument("--ais", default=os.path.join(ROOT, "target", "release", "ais"),
+                        help="the ais binary")
+    parser.add_argument("--out", default=os.path.join(ROOT, "target", "crosscheck"),
+                        help="folder for the images and summary.json")
+    args = parser.parse_args()
+
+    if args.setup:
+        python = setup_venv(args.venv)
+        if not args.scenes and not args.suite:
+            print(f"crosscheck: ready; run {python} {sys.argv[0]} ...")
+            return
+        argv = [a for a in sys.argv[1:] if a != "--setup"]
+        sys.exit(subprocess.run([python, os.path.abspath(__file__)] + argv).returncode)
+    try:
+        import numpy  # noqa: F401
+        import mitsuba
+    except ImportError as e:
+        fail_setup(f"{e}; run `python3 tools/crosscheck.py --setup` (makes .venv with "
+                   f"mitsuba=={MITSUBA_VERSION} and numpy) or `pip install mitsuba numpy`")
+    mitsuba.set_variant("scalar_rgb")
+    scenes = args.scenes + (suite_scenes() if args.suite else [])
+    if not scenes:
+        parser.error("give scene files or --suite")
+    if not os.path.exists(args.ais):
+        fail_setup(f"{args.ais} not found; run `cargo build --release -p ais-cli` first")
+    if args.spp % args.runs or args.runs < 2:
+        parser.error("--spp must be a multiple of --runs, and --runs at least 2")
+    width, height = (int(v) for v in args.size.lower().split("x"))
+    modes = [m for m in args.modes.split(",") if m]
+    ensure_assets()
+    os.makedirs(args.out, exist_ok=True)
+
+    spp_per_run = args.spp // args.runs
+    print(f"crosscheck: Mitsuba {mitsuba.__version__} scalar_rgb direct ({args.mitsuba_samples}+"
+          f"{args.mitsuba_samples} samples) vs ais gather mis n={args.rays}; {width}x{height}, "
+          f"{args.spp} spp in {args.runs} runs each")
+    header = f"{'scene':<28} {'ais':<11} {'R ratio':>8} {'G ratio':>8} {'B ratio':>8} " \
+             f"{'relMSE':>9} {'(noise)':>9} {'block SE':>9}  verdict"
+    print(header)
+    summary, failed = [], []
+    for scene in scenes:
+        name = os.path.splitext(os.path.relpath(scene, os.path.join(ROOT, "scenes")))[0].replace(os.sep, "-")
+        started = time.time()
+        with tempfile.TemporaryDirectory() as work:
+            theirs = render_mitsuba(scene, width, height, args.runs, spp_per_run, args.mitsuba_samples, work)
+            mitsuba_seconds = time.time() - started
+            save(os.path.join(args.out, f"{name}-mitsuba.exr"), theirs.mean(0))
+            for mode in modes:
+                started = time.time()
+                ours = render_ais(args.ais, scene, width, height, args.runs, spp_per_run, args.rays, mode, work)
+                ais_seconds = time.time() - started
+                stats = statistics(ours, theirs)
+                failures = check(stats)
+                stem = os.path.join(args.out, f"{name}-ais-{mode}")
+                save(stem + ".exr", stats["mean_ours"])
+                save(stem + "-se.exr", stats["z"])
+                save(stem + "-se.png", false_colour(stats["z_sum"]))
+                r, g, b = stats["mean_ratio"]
+                print(f"{name:<28} {mode:<11} {r:8.4f} {g:8.4f} {b:8.4f} {stats['rel_mse']:9.2e} "
+                      f"{stats['rel_mse_noise_floor']:9.2e} {stats['worst_block_se']:+9.2f}  "
+                      f"{'ok' if not failures else 'FAIL'}", flush=True)
+                for failure in failures:
+                    print(f"    {failure}")
+                    failed.append(f"{name} (ais {mode}): {failure}")
+                summary.append({key: value for key, value in stats.items()
+                                if key not in ("z", "z_sum", "mean_ours", "mean_theirs")}
+                               | {"scene": os.path.relpath(scene, ROOT), "mode": mode, "failures": failures,
+                                  "mitsuba_seconds": mitsuba_seconds, "ais_seconds": ais_seconds})
+    with open(os.path.join(args.out, "summary.json.part"), "w") as f:
+        json.dump({"size": [width, height], "spp": args.spp, "runs": args.runs, "rays": args.rays,
+                   "mitsuba_samples": args.mitsuba_samples, "results": summary}, f, indent=1)
+    os.replace(os.path.join(args.out, "summary.json.part"), os.path.join(args.out, "summary.json"))
+    print(f"crosscheck: images and summary.json in {args.out}")
+    if failed:
+        print(f"crosscheck: {len(failed)} threshold(s) exceeded:", file=sys.stderr)
+        for line in failed:
+            print(f"  {line}", file=sys.stderr)
+        sys.exit(1)
+    print("crosscheck: all scenes agree within the thresholds")
 
 
 if __name__ == "__main__":

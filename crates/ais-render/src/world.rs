@@ -45,6 +45,9 @@ impl World {
                 Some(index) => {
                     Material::from_plugin(&description.bsdfs[index], &file, &mut warnings)
                 }
+                // As in Mitsuba: a shape without a BSDF is diffuse 0.5, or black when it
+                // emits (so that a light does not also reflect the other lights).
+                None if shape.emitter.is_some() => Material::diffuse(Vec3::ZERO),
                 None => Material::default(),
             });
             let radiance = shape

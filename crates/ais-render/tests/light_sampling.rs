@@ -7,7 +7,7 @@ mod common;
 use ais::chi2::chi_square_p_value;
 use ais::mapping::LatLong;
 use ais::rng::Pcg32;
-use ais_render::bsdf::{Ggx, Material, Scattering, ShadingFrame};
+use ais_render::bsdf::{Material, Microfacet, RoughPlastic, Scattering, ShadingFrame};
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
 use ais_render::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights, Rectangle};
@@ -101,25 +101,60 @@ fn gradient_with_sun(width: usize, height: usize) -> RgbImage {
     image
 }
 
+/// The direction of Mitsuba's (u, v) in an envmap's local frame.
+fn mitsuba_direction(u: f64, v: f64) -> Vec3 {
+    let (phi, theta) = (2.0 * std::f64::consts::PI * u, std::f64::consts::PI * v);
+    Vec3::new(
+        (phi.sin() * theta.sin()) as f32,
+        theta.cos() as f32,
+        (-phi.cos() * theta.sin()) as f32,
+    )
+}
+
 #[test]
-fn envmap_orientation_follows_mitsuba() {
-    // Mitsuba: u = atan2(x, -z) / 2π, v = acos(y) / π in the emitter's frame.
-    let (width, height) = (64, 32);
+fn envmap_orientation_and_filtering_follow_mitsuba() {
+    // Mitsuba: u = atan2(x, −z) / 2π, v = acos(y) / π in the emitter's frame; texel centres
+    // at u = (column + ½) / W and v = row / (H − 1); bilinear in between, periodic in u.
+    let (width, height) = (64, 33);
+    let centre = |column: usize, row: usize| {
+        mitsuba_direction(
+            (column as f64 + 0.5) / width as f64,
+            row as f64 / (height - 1) as f64,
+        )
+    };
     let mut image = RgbImage::new(width, height);
-    image.pixels[(height / 2) * width + width / 4] = [1.0, 0.0, 0.0]; // u = 0.25, v = 0.5: +x
-    image.pixels[(height / 2) * width] = [0.0, 1.0, 0.0]; // u = 0, v = 0.5: −z
-    image.pixels[0] = [0.0, 0.0, 1.0]; // v = 0: +y (any u)
-    let env = Environment::Map(Box::new(EnvironmentMap::new(image, DMat3::IDENTITY)));
-    let dir = |x: f32, y: f32, z: f32| Vec3::new(x, y, z).normalize();
-    assert_eq!(env.radiance(dir(1.0, -0.01, 0.001)), Vec3::X);
-    assert_eq!(env.radiance(dir(0.001, -0.01, -1.0)), Vec3::Y);
-    assert_eq!(env.radiance(dir(0.0, 1.0, -0.01)), Vec3::Z);
+    image.pixels[16 * width + 15] = [1.0, 0.0, 0.0];
+    image.pixels[16 * width + 63] = [0.0, 1.0, 0.0];
+    image.pixels[5 * width + 40] = [0.0, 0.0, 2.0];
+    let env = Environment::Map(Box::new(EnvironmentMap::new(
+        image.clone(),
+        DMat3::IDENTITY,
+    )));
+    let close = |a: Vec3, b: Vec3| (a - b).abs().max_element() < 1e-4;
+    assert!(close(env.radiance(centre(15, 16)), Vec3::X));
+    assert!(close(env.radiance(centre(63, 16)), Vec3::Y));
+    assert!(close(env.radiance(centre(40, 5)), Vec3::new(0.0, 0.0, 2.0)));
+    // u = 0 lies halfway between the last column and the first: periodic interpolation.
+    assert!(close(
+        env.radiance(mitsuba_direction(0.0, 0.5)),
+        Vec3::new(0.0, 0.5, 0.0)
+    ));
+    // Halfway between rows 5 and 6, and a quarter of the way from column 40 to 41.
+    let between = mitsuba_direction(40.75 / width as f64, 5.5 / (height - 1) as f64);
+    assert!(close(env.radiance(between), Vec3::new(0.0, 0.0, 0.75)));
+    // Mitsuba's +x is u = 1/4 on the equator, −z is u = 0, +y the first row.
+    image.pixels[16 * width + 16] = [1.0, 0.0, 0.0];
+    image.pixels[..width].fill([0.0, 0.0, 1.0]);
+    let env = Environment::Map(Box::new(EnvironmentMap::new(
+        image.clone(),
+        DMat3::IDENTITY,
+    )));
+    assert!(close(env.radiance(Vec3::X), Vec3::X));
+    assert!(close(env.radiance(Vec3::Y), Vec3::Z));
     // to_world rotates the frame: a 90° turn about +y moves +x to −z.
-    let mut rotated_image = RgbImage::new(width, height);
-    rotated_image.pixels[(height / 2) * width + width / 4] = [1.0, 0.0, 0.0];
     let rotation = DMat3::from_rotation_y(std::f64::consts::FRAC_PI_2);
-    let rotated = Environment::Map(Box::new(EnvironmentMap::new(rotated_image, rotation)));
-    assert_eq!(rotated.radiance(dir(0.001, -0.01, -1.0)), Vec3::X);
+    let rotated = Environment::Map(Box::new(EnvironmentMap::new(image, rotation)));
+    assert!(close(rotated.radiance(-Vec3::Z), Vec3::X));
 }
 
 #[test]
@@ -322,10 +357,10 @@ fn views() -> Vec<(ShadingFrame, Vec3)> {
         .collect()
 }
 
-fn conductor(alpha: f32) -> Material {
+fn conductor(microfacet: Microfacet) -> Material {
     Material {
         scattering: Scattering::RoughConductor {
-            ggx: Ggx::new(alpha),
+            microfacet,
             eta: Vec3::ZERO,
             k: Vec3::ZERO,
             specular: Vec3::ONE,
@@ -336,20 +371,26 @@ fn conductor(alpha: f32) -> Material {
 
 fn plastic(alpha: f32, diffuse: Vec3) -> Material {
     Material {
-        scattering: Scattering::RoughPlastic {
-            ggx: Ggx::new(alpha),
-            eta: 1.49,
+        scattering: Scattering::RoughPlastic(RoughPlastic::new(
+            Microfacet::beckmann(alpha),
+            1.49,
             diffuse,
-            specular: 1.0,
-        },
+            Vec3::ONE,
+            false,
+        )),
         two_sided: false,
     }
 }
 
 #[test]
-fn ggx_conductor_visible_normal_sampling_fits() {
-    for alpha in [0.15, 0.6] {
-        let material = conductor(alpha);
+fn conductor_sampling_fits_for_both_distributions() {
+    for microfacet in [
+        Microfacet::ggx(0.15),
+        Microfacet::ggx(0.6),
+        Microfacet::beckmann(0.15),
+        Microfacet::beckmann(0.6),
+    ] {
+        let material = conductor(microfacet);
         for (seed, (frame, wo)) in views().into_iter().enumerate() {
             let p = fit(
                 200_000,
@@ -357,7 +398,7 @@ fn ggx_conductor_visible_normal_sampling_fits() {
                 |u| Some(material.sample(&frame, wo, u)).filter(|s| s.1 > 0.0),
                 |d| material.pdf(&frame, wo, d),
             );
-            assert!(p > SIGNIFICANCE, "alpha {alpha}, view {seed}: p = {p}");
+            assert!(p > SIGNIFICANCE, "{microfacet:?}, view {seed}: p = {p}");
         }
     }
 }
@@ -380,7 +421,11 @@ fn rough_plastic_sampling_fits() {
 fn microfacet_bsdfs_do_not_create_energy() {
     // Albedo = ∫ f cos dωi ≤ 1 for every view, estimated by importance sampling.
     let mut rng = Pcg32::new(40, 1);
-    for material in [conductor(0.5), plastic(0.3, Vec3::ONE)] {
+    for material in [
+        conductor(Microfacet::ggx(0.5)),
+        conductor(Microfacet::beckmann(0.5)),
+        plastic(0.3, Vec3::ONE),
+    ] {
         for (frame, wo) in views() {
             let n = 100_000;
             let mut sum = 0.0;

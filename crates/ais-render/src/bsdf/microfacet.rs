@@ -1,22 +1,49 @@
-//! The isotropic GGX (Trowbridge-Reitz) microfacet distribution with Smith shadowing and
-//! visible-normal sampling (Heitz 2018), in a local frame where the normal is +z.
+//! Isotropic microfacet distributions, Beckmann and GGX (Trowbridge-Reitz), with Smith
+//! masking, in a local frame where the normal is +z. As in Mitsuba 3: `alpha` is the
+//! distribution's width, Beckmann is the default when a scene names none, Beckmann's
+//! masking uses Walter et al.'s rational approximation of Smith's G1, and shadowing-masking
+//! is the separable product G1(wi) G1(wo). GGX is sampled by its visible normals (Heitz
+//! 2018); Beckmann by its normal distribution D(h) cos θh (exact, though noisier at grazing
+//! views than Mitsuba's visible-normal sampler).
 
 use glam::Vec3;
 use std::f32::consts::PI;
 
-/// GGX with roughness `alpha` (Mitsuba's `alpha`, the distribution's width).
+/// Which distribution of microfacet normals.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum MicrofacetKind {
+    /// exp(−tan²θ/α²) / (π α² cos⁴θ), Mitsuba's default.
+    Beckmann,
+    /// α² / (π cos⁴θ (α² + tan²θ)²).
+    Ggx,
+}
+
+/// A microfacet distribution of roughness `alpha`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Ggx {
+pub struct Microfacet {
+    /// The distribution's shape.
+    pub kind: MicrofacetKind,
     /// Roughness, clamped to [1e-4, 1].
     pub alpha: f32,
 }
 
-impl Ggx {
+impl Microfacet {
     /// A distribution of roughness `alpha`.
-    pub fn new(alpha: f32) -> Self {
-        Ggx {
+    pub fn new(kind: MicrofacetKind, alpha: f32) -> Self {
+        Microfacet {
+            kind,
             alpha: alpha.clamp(1e-4, 1.0),
         }
+    }
+
+    /// GGX of roughness `alpha`.
+    pub fn ggx(alpha: f32) -> Self {
+        Microfacet::new(MicrofacetKind::Ggx, alpha)
+    }
+
+    /// Beckmann of roughness `alpha`.
+    pub fn beckmann(alpha: f32) -> Self {
+        Microfacet::new(MicrofacetKind::Beckmann, alpha)
     }
 
     /// Density of microfacet normals `h` (per projected area).
@@ -25,36 +52,77 @@ impl Ggx {
             return 0.0;
         }
         let a2 = self.alpha * self.alpha;
-        let denominator = (a2 - 1.0) * h.z * h.z + 1.0;
-        a2 / (PI * denominator * denominator)
-    }
-
-    /// Smith's Λ for direction `w`.
-    fn lambda(&self, w: Vec3) -> f32 {
-        let cos2 = w.z * w.z;
-        if cos2 <= 0.0 {
-            return f32::INFINITY;
-        }
-        let tan2 = (1.0 - cos2).max(0.0) / cos2;
-        0.5 * (-1.0 + (1.0 + self.alpha * self.alpha * tan2).sqrt())
-    }
-
-    /// Smith's masking for one direction.
-    pub fn g1(&self, w: Vec3) -> f32 {
-        if w.z <= 0.0 {
-            0.0
-        } else {
-            1.0 / (1.0 + self.lambda(w))
+        let cos2 = h.z * h.z;
+        match self.kind {
+            MicrofacetKind::Ggx => {
+                let denominator = (a2 - 1.0) * cos2 + 1.0;
+                a2 / (PI * denominator * denominator)
+            }
+            MicrofacetKind::Beckmann => {
+                let tan2 = (1.0 - cos2).max(0.0) / cos2;
+                (-tan2 / a2).exp() / (PI * a2 * cos2 * cos2)
+            }
         }
     }
 
-    /// Separable masking-shadowing, G1(wi) G1(wo) (Mitsuba's choice).
-    pub fn g(&self, wi: Vec3, wo: Vec3) -> f32 {
-        self.g1(wi) * self.g1(wo)
+    /// Smith's masking of direction `w` (either side of the surface) by microfacet `m`:
+    /// zero when `w` sees the back of `m`.
+    pub fn g1(&self, w: Vec3, m: Vec3) -> f32 {
+        if w.dot(m) * w.z <= 0.0 {
+            return 0.0;
+        }
+        let xy2 = w.x * w.x + w.y * w.y;
+        if xy2 == 0.0 {
+            return 1.0;
+        }
+        let tan2_alpha2 = self.alpha * self.alpha * xy2 / (w.z * w.z);
+        match self.kind {
+            MicrofacetKind::Ggx => 2.0 / (1.0 + (1.0 + tan2_alpha2).sqrt()),
+            MicrofacetKind::Beckmann => {
+                let a = 1.0 / tan2_alpha2.sqrt();
+                if a >= 1.6 {
+                    1.0
+                } else {
+                    (3.535 * a + 2.181 * a * a) / (1.0 + 2.276 * a + 2.577 * a * a)
+                }
+            }
+        }
     }
 
-    /// A visible normal for viewing direction `wo` (z > 0).
-    pub fn sample_visible(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
+    /// Separable masking-shadowing G1(wi, h) G1(wo, h).
+    pub fn g(&self, wi: Vec3, wo: Vec3, h: Vec3) -> f32 {
+        self.g1(wi, h) * self.g1(wo, h)
+    }
+
+    /// A microfacet normal for viewing direction `wo` (z > 0): visible normals for GGX,
+    /// D(h) cos θh for Beckmann.
+    pub fn sample(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
+        match self.kind {
+            MicrofacetKind::Ggx => self.sample_visible_ggx(wo, u),
+            MicrofacetKind::Beckmann => {
+                let tan2 = -self.alpha * self.alpha * (1.0 - u[0]).max(1e-30).ln();
+                let cos = 1.0 / (1.0 + tan2).sqrt();
+                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                let phi = 2.0 * PI * u[1];
+                Vec3::new(sin * phi.cos(), sin * phi.sin(), cos)
+            }
+        }
+    }
+
+    /// Density of [`Microfacet::sample`] at normal `h`.
+    pub fn pdf(&self, wo: Vec3, h: Vec3) -> f32 {
+        match self.kind {
+            MicrofacetKind::Ggx => {
+                if wo.z <= 0.0 {
+                    return 0.0;
+                }
+                self.g1(wo, h) * wo.dot(h).max(0.0) * self.d(h) / wo.z
+            }
+            MicrofacetKind::Beckmann => self.d(h) * h.z.max(0.0),
+        }
+    }
+
+    fn sample_visible_ggx(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
         // Stretch the view so that the distribution becomes the unit hemisphere.
         let v = Vec3::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
         let length2 = v.x * v.x + v.y * v.y;
@@ -71,14 +139,6 @@ impl Ggx {
         let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
         let n = t1 * p1 + t2 * p2 + v * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
         Vec3::new(self.alpha * n.x, self.alpha * n.y, n.z.max(1e-6)).normalize()
-    }
-
-    /// Density of [`Ggx::sample_visible`]: G1(wo) max(0, wo·h) D(h) / wo.z.
-    pub fn pdf_visible(&self, wo: Vec3, h: Vec3) -> f32 {
-        if wo.z <= 0.0 {
-            return 0.0;
-        }
-        self.g1(wo) * wo.dot(h).max(0.0) * self.d(h) / wo.z
     }
 }
 
@@ -126,17 +186,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn ggx_normals_integrate_to_one_over_projected_area() {
+    fn normals_integrate_to_one_over_projected_area() {
         // ∫ D(h) cos θh dω = 1.
-        let ggx = Ggx::new(0.3);
-        let n = 400;
-        let mut sum = 0.0;
-        for i in 0..n {
-            let cos = (i as f32 + 0.5) / n as f32;
-            let h = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
-            sum += ggx.d(h) * cos * 2.0 * PI / n as f32;
+        for distribution in [Microfacet::ggx(0.3), Microfacet::beckmann(0.3)] {
+            let n = 4000;
+            let mut sum = 0.0;
+            for i in 0..n {
+                let cos = (i as f32 + 0.5) / n as f32;
+                let h = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+                sum += distribution.d(h) * cos * 2.0 * PI / n as f32;
+            }
+            assert!((sum - 1.0).abs() < 0.01, "{distribution:?}: {sum}");
         }
-        assert!((sum - 1.0).abs() < 0.01, "{sum}");
     }
 
     #[test]

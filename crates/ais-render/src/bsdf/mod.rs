@@ -1,10 +1,13 @@
 //! BSDFs: Mitsuba's `diffuse`, `roughconductor` and `roughplastic` (GGX, visible-normal
-//! sampling) and the `twosided` adapter. `roughplastic` is a documented approximation of
-//! Mitsuba's (see [`Scattering::RoughPlastic`]).
+//! sampling) and the `twosided` adapter, each evaluating as Mitsuba 3 does.
 
+mod conductors;
 mod microfacet;
+mod rough_plastic;
 
-pub use microfacet::{fresnel_conductor, fresnel_dielectric, Ggx};
+pub use conductors::named_conductor;
+pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
+pub use rough_plastic::RoughPlastic;
 
 use crate::geometry::{basis, cosine_hemisphere};
 use crate::scene::{Plugin, Property};
@@ -12,17 +15,17 @@ use glam::Vec3;
 use std::f32::consts::PI;
 
 /// How a surface scatters, in its local frame (normal +z).
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum Scattering {
     /// Lambertian reflection.
     Diffuse {
         /// Albedo.
         reflectance: Vec3,
     },
-    /// GGX reflection off a conductor.
+    /// Microfacet reflection off a conductor.
     RoughConductor {
-        /// Microfacet roughness.
-        ggx: Ggx,
+        /// Microfacet distribution.
+        microfacet: Microfacet,
         /// Real part of the complex index of refraction.
         eta: Vec3,
         /// Imaginary part; `eta = k = 0` stands for Mitsuba's `material = "none"` (F = 1).
@@ -30,24 +33,12 @@ pub enum Scattering {
         /// Multiplier of the reflectance.
         specular: Vec3,
     },
-    /// GGX specular reflection off a dielectric coating over a Lambertian base:
-    /// `F(wi·h) D G / (4 cos θi cos θo)` plus `ρ_d / π · (1 − F(cos θi)) (1 − F(cos θo))`.
-    /// Mitsuba's roughplastic adds internal scattering and a rough-interface transmittance
-    /// table; this approximation is unbiased for itself but not identical to Mitsuba's.
-    RoughPlastic {
-        /// Microfacet roughness.
-        ggx: Ggx,
-        /// Relative index, interior over exterior.
-        eta: f32,
-        /// Albedo of the base.
-        diffuse: Vec3,
-        /// Multiplier of the specular lobe.
-        specular: f32,
-    },
+    /// Mitsuba's `roughplastic`: a GGX dielectric coating over a Lambertian base.
+    RoughPlastic(RoughPlastic),
 }
 
 /// A surface's scattering and sidedness.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct Material {
     /// The BSDF.
     pub scattering: Scattering,
@@ -143,18 +134,29 @@ impl Material {
         let mut warn = |message: String| {
             warnings.push(format!("{}:{}: {message}", file.display(), plugin.line))
         };
-        let alpha = |warn: &mut dyn FnMut(String)| -> Ggx {
+        let microfacet = |warn: &mut dyn FnMut(String)| -> Microfacet {
             if plugin.properties.contains_key("alpha_u")
                 || plugin.properties.contains_key("alpha_v")
             {
                 warn("anisotropic alpha_u/alpha_v are not supported; using alpha".into());
             }
-            if let Ok(Some(d)) = plugin.string("distribution") {
-                if d != "ggx" {
-                    warn(format!("microfacet distribution \"{d}\" replaced by ggx"));
+            // Mitsuba's default distribution is Beckmann.
+            let kind = match plugin.string("distribution") {
+                Ok(None) => MicrofacetKind::Beckmann,
+                Ok(Some(d)) if d.eq_ignore_ascii_case("beckmann") => MicrofacetKind::Beckmann,
+                Ok(Some(d)) if d.eq_ignore_ascii_case("ggx") => MicrofacetKind::Ggx,
+                Ok(Some(d)) => {
+                    warn(format!(
+                        "microfacet distribution \"{d}\" is not beckmann or ggx; using beckmann"
+                    ));
+                    MicrofacetKind::Beckmann
                 }
-            }
-            Ggx::new(plugin.float("alpha", 0.1).unwrap_or(0.1) as f32)
+                Err((_, message)) => {
+                    warn(message);
+                    MicrofacetKind::Beckmann
+                }
+            };
+            Microfacet::new(kind, plugin.float("alpha", 0.1).unwrap_or(0.1) as f32)
         };
         let checked = |value: Result<Vec3, String>, warn: &mut dyn FnMut(String), default: Vec3| {
             match value {
@@ -179,7 +181,7 @@ impl Material {
                 Material::diffuse(reflectance.min(Vec3::ONE))
             }
             "roughconductor" => {
-                let ggx = alpha(&mut warn);
+                let microfacet = microfacet(&mut warn);
                 let (eta, k) = if plugin.properties.contains_key("eta")
                     || plugin.properties.contains_key("k")
                 {
@@ -210,7 +212,7 @@ impl Material {
                 );
                 Material {
                     scattering: Scattering::RoughConductor {
-                        ggx,
+                        microfacet,
                         eta,
                         k,
                         specular,
@@ -219,7 +221,7 @@ impl Material {
                 }
             }
             "roughplastic" => {
-                let ggx = alpha(&mut warn);
+                let microfacet = microfacet(&mut warn);
                 let int_ior = plugin.float("int_ior", 1.49).unwrap_or(1.49);
                 let ext_ior = plugin.float("ext_ior", 1.000277).unwrap_or(1.000277);
                 let diffuse = checked(
@@ -232,19 +234,24 @@ impl Material {
                     &mut warn,
                     Vec3::ONE,
                 );
-                if plugin.boolean("nonlinear", false).unwrap_or(false) {
-                    warn(
-                        "roughplastic nonlinear = true is not supported; using the linear model"
-                            .into(),
-                    );
-                }
+                let nonlinear = plugin.boolean("nonlinear", false).unwrap_or(false);
+                let eta = (int_ior / ext_ior) as f32;
+                let eta = if eta.is_finite() && eta > 0.0 && eta != 1.0 {
+                    eta
+                } else {
+                    warn(format!(
+                        "int_ior / ext_ior = {eta} must be positive and not 1; using 1.49"
+                    ));
+                    1.49
+                };
                 Material {
-                    scattering: Scattering::RoughPlastic {
-                        ggx,
-                        eta: (int_ior / ext_ior).max(1.0001) as f32,
-                        diffuse: diffuse.min(Vec3::ONE),
-                        specular: specular.max_element(),
-                    },
+                    scattering: Scattering::RoughPlastic(RoughPlastic::new(
+                        microfacet,
+                        eta,
+                        diffuse.min(Vec3::ONE),
+                        specular,
+                        nonlinear,
+                    )),
                     two_sided: false,
                 }
             }
@@ -286,7 +293,7 @@ impl Material {
         match self.scattering {
             Scattering::Diffuse { reflectance } => reflectance * (i.z / PI),
             Scattering::RoughConductor {
-                ggx,
+                microfacet,
                 eta,
                 k,
                 specular,
@@ -297,35 +304,9 @@ impl Material {
                 } else {
                     fresnel_conductor(i.dot(h), eta, k)
                 };
-                specular * fresnel * (ggx.d(h) * ggx.g(i, o) / (4.0 * o.z))
+                specular * fresnel * (microfacet.d(h) * microfacet.g(i, o, h) / (4.0 * o.z))
             }
-            Scattering::RoughPlastic {
-                ggx,
-                eta,
-                diffuse,
-                specular,
-            } => {
-                let h = (o + i).normalize();
-                let glossy = specular * fresnel_dielectric(i.dot(h), eta) * ggx.d(h) * ggx.g(i, o)
-                    / (4.0 * o.z);
-                let base = diffuse
-                    * ((1.0 - fresnel_dielectric(i.z, eta))
-                        * (1.0 - fresnel_dielectric(o.z, eta))
-                        * i.z
-                        / PI);
-                base + Vec3::splat(glossy)
-            }
-        }
-    }
-
-    /// Probability of choosing the specular lobe of a rough plastic when sampling.
-    fn specular_probability(o: Vec3, eta: f32, diffuse: Vec3, specular: f32) -> f32 {
-        let s = specular * fresnel_dielectric(o.z, eta);
-        let d = crate::lights::luminance(diffuse) * (1.0 - fresnel_dielectric(o.z, eta));
-        if s + d > 0.0 {
-            (s / (s + d)).clamp(0.1, 0.9)
-        } else {
-            0.5
+            Scattering::RoughPlastic(ref plastic) => plastic.eval(o, i),
         }
     }
 
@@ -335,24 +316,17 @@ impl Material {
         let reflect = |h: Vec3| 2.0 * o.dot(h) * h - o;
         let local = match self.scattering {
             Scattering::Diffuse { .. } => cosine_hemisphere(u),
-            Scattering::RoughConductor { ggx, .. } => {
+            Scattering::RoughConductor { microfacet, .. } => {
                 if o.z <= 0.0 {
                     return (frame.normal, 0.0);
                 }
-                reflect(ggx.sample_visible(o, u))
+                reflect(microfacet.sample(o, u))
             }
-            Scattering::RoughPlastic {
-                ggx,
-                eta,
-                diffuse,
-                specular,
-            } => {
-                let p = Self::specular_probability(o, eta, diffuse, specular);
-                if u[0] < p && o.z > 0.0 {
-                    reflect(ggx.sample_visible(o, [u[0] / p, u[1]]))
-                } else {
-                    cosine_hemisphere([((u[0] - p) / (1.0 - p)).clamp(0.0, 1.0 - 1e-7), u[1]])
+            Scattering::RoughPlastic(ref plastic) => {
+                if o.z <= 0.0 {
+                    return (frame.normal, 0.0);
                 }
+                plastic.sample(o, u)
             }
         };
         let wi = frame.to_world(local).normalize();
@@ -366,7 +340,7 @@ impl Material {
             return 0.0;
         }
         let cosine = i.z / PI;
-        let microfacet = |ggx: Ggx| {
+        let reflection_pdf = |microfacet: Microfacet| {
             if o.z <= 0.0 {
                 return 0.0;
             }
@@ -375,54 +349,20 @@ impl Material {
             if oh <= 0.0 {
                 0.0
             } else {
-                ggx.pdf_visible(o, h) / (4.0 * oh)
+                microfacet.pdf(o, h) / (4.0 * oh)
             }
         };
         (match self.scattering {
             Scattering::Diffuse { .. } => cosine,
-            Scattering::RoughConductor { ggx, .. } => microfacet(ggx),
-            Scattering::RoughPlastic {
-                ggx,
-                eta,
-                diffuse,
-                specular,
-            } => {
-                let p = Self::specular_probability(o, eta, diffuse, specular);
-                if o.z > 0.0 {
-                    p * microfacet(ggx) + (1.0 - p) * cosine
-                } else {
-                    cosine
+            Scattering::RoughConductor { microfacet, .. } => reflection_pdf(microfacet),
+            Scattering::RoughPlastic(ref plastic) => {
+                if o.z <= 0.0 {
+                    return 0.0;
                 }
+                plastic.pdf(o, i, reflection_pdf(plastic.microfacet))
             }
         }) as f64
     }
-}
-
-/// Complex indices of refraction (at roughly 650, 550 and 450 nm) of common conductors.
-fn named_conductor(name: &str) -> Option<(Vec3, Vec3)> {
-    Some(match name {
-        "Au" => (
-            Vec3::new(0.143, 0.374, 1.442),
-            Vec3::new(3.983, 2.385, 1.603),
-        ),
-        "Ag" => (
-            Vec3::new(0.155, 0.117, 0.138),
-            Vec3::new(4.828, 3.122, 2.147),
-        ),
-        "Cu" => (
-            Vec3::new(0.200, 0.924, 1.102),
-            Vec3::new(3.912, 2.452, 2.142),
-        ),
-        "Al" => (
-            Vec3::new(1.657, 0.880, 0.521),
-            Vec3::new(9.224, 6.270, 4.837),
-        ),
-        "Cr" => (
-            Vec3::new(3.105, 3.182, 2.223),
-            Vec3::new(3.324, 3.332, 3.109),
-        ),
-        _ => return None,
-    })
 }
 
 #[cfg(test)]
@@ -452,9 +392,11 @@ mod tests {
                <bsdf type="twosided" id="d"><bsdf type="diffuse"><float name="reflectance" value="0.3"/></bsdf></bsdf>"#,
         );
         assert!(warnings.is_empty(), "{warnings:?}");
-        match m[0].scattering {
-            Scattering::RoughConductor { ggx, eta, .. } => {
-                assert_eq!(ggx.alpha, 0.3);
+        match &m[0].scattering {
+            Scattering::RoughConductor {
+                microfacet, eta, ..
+            } => {
+                assert_eq!(*microfacet, Microfacet::beckmann(0.3));
                 assert!(eta.x < 0.2);
             }
             other => panic!("{other:?}"),
@@ -462,10 +404,10 @@ mod tests {
         assert!(
             matches!(m[1].scattering, Scattering::RoughConductor { eta, k, .. } if eta == Vec3::ZERO && k == Vec3::ZERO)
         );
-        match m[2].scattering {
-            Scattering::RoughPlastic { eta, diffuse, .. } => {
-                assert!((eta - 1.5 / 1.000277).abs() < 1e-5);
-                assert_eq!(diffuse, Vec3::new(0.2, 0.4, 0.6));
+        match &m[2].scattering {
+            Scattering::RoughPlastic(plastic) => {
+                assert!((plastic.eta - 1.5 / 1.000277).abs() < 1e-5);
+                assert_eq!(plastic.diffuse, Vec3::new(0.2, 0.4, 0.6));
             }
             other => panic!("{other:?}"),
         }

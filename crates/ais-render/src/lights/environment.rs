@@ -1,10 +1,15 @@
 //! Infinite lights: Mitsuba's `envmap` (a lat-long image) and `constant`.
 //!
-//! Orientation follows Mitsuba 3: in the emitter's local frame (+y up) a direction d maps to
-//! u = atan2(d.x, −d.z) / 2π and v = acos(d.y) / π, with (u, v) = (0, 0) at the top-left of
-//! the image; `to_world` rotates that frame and `scale` multiplies the radiance. Radiance is
-//! looked up at the nearest texel (Mitsuba filters bilinearly; see the README), and sampling
-//! is piecewise constant over texels, weighted by luminance · sin θ.
+//! Orientation and filtering follow Mitsuba 3 exactly. In the emitter's local frame (+y up)
+//! a direction d maps to u = atan2(d.x, −d.z) / 2π and v = acos(d.y) / π, with (u, v) =
+//! (0, 0) at the top-left of the image; `to_world` rotates that frame and `scale` multiplies
+//! the radiance. Radiance is interpolated bilinearly between texels, whose centres sit at
+//! u = (column + ½) / W (periodic in u) and at v = row / (H − 1): the first row is the north
+//! pole and the last the south pole ("align corners" in v).
+//!
+//! Sampling is piecewise constant in solid angle over the cells between four neighbouring
+//! texel centres, each weighted by the mean luminance of its corners times its solid angle,
+//! so the density is positive wherever the interpolated radiance is.
 
 use crate::distribution::Distribution2D;
 use crate::geometry::uniform_sphere;
@@ -32,36 +37,54 @@ pub struct EnvironmentMap {
     image: RgbImage,
     to_world: DMat3,
     to_local: DMat3,
+    /// Over `width × (height − 1)` cells; cell (c, r) has texel centres (c, r) and
+    /// (c + 1, r + 1) at its corners.
     distribution: Distribution2D,
+    /// cos θ of each texel row.
+    row_cosines: Vec<f64>,
     mean_luminance: f64,
 }
 
 impl EnvironmentMap {
     /// An environment from a (sanitised) image already multiplied by the emitter's `scale`,
-    /// and the rotation part of its `to_world`.
-    pub fn new(image: RgbImage, to_world: DMat3) -> Self {
+    /// and the rotation part of its `to_world`. A one-row image is treated as two equal rows.
+    pub fn new(mut image: RgbImage, to_world: DMat3) -> Self {
+        if image.height == 1 {
+            image.pixels.extend_from_within(..);
+            image.height = 2;
+        }
         let (width, height) = (image.width, image.height);
-        let mut weights = Vec::with_capacity(width * height);
-        let mut mean = 0.0;
-        for row in 0..height {
-            let sin_theta = (PI * (row as f64 + 0.5) / height as f64).sin();
+        let row_cosines: Vec<f64> = (0..height)
+            .map(|row| (PI * row as f64 / (height - 1) as f64).cos())
+            .collect();
+        let texel_luminance = |column: usize, row: usize| {
+            luminance(Vec3::from(image.pixels[row * width + column % width])) as f64
+        };
+        let mut weights = Vec::with_capacity(width * (height - 1));
+        let mut integral = 0.0;
+        for row in 0..height - 1 {
+            let cell_solid_angle =
+                2.0 * PI / width as f64 * (row_cosines[row] - row_cosines[row + 1]);
             for column in 0..width {
-                let l = luminance(Vec3::from(image.pixels[row * width + column])) as f64;
-                weights.push(l * sin_theta);
-                mean += l * sin_theta;
+                let corners = texel_luminance(column, row)
+                    + texel_luminance(column + 1, row)
+                    + texel_luminance(column, row + 1)
+                    + texel_luminance(column + 1, row + 1);
+                weights.push(corners / 4.0 * cell_solid_angle);
+                integral += corners / 4.0 * cell_solid_angle;
             }
         }
-        // Mean luminance over the sphere: Σ L sinθ ΔθΔφ / 4π with ΔθΔφ = 2π²/(W H).
-        let mean_luminance = mean * 2.0 * PI * PI / (width * height) as f64 / (4.0 * PI);
         EnvironmentMap {
-            distribution: Distribution2D::new(&weights, width, height),
+            distribution: Distribution2D::new(&weights, width, height - 1),
             to_local: to_world.inverse(),
             to_world,
             image,
-            mean_luminance,
+            row_cosines,
+            mean_luminance: integral / (4.0 * PI),
         }
     }
 
+    /// Mitsuba's (u, v) of a world direction: u ∈ [0, 1), v ∈ [0, 1].
     fn uv(&self, direction: Vec3) -> [f64; 2] {
         let d = self.to_local * direction.as_dvec3();
         let mut u = d.x.atan2(-d.z) / (2.0 * PI);
@@ -71,17 +94,58 @@ impl EnvironmentMap {
         [u.min(1.0 - f64::EPSILON), d.y.clamp(-1.0, 1.0).acos() / PI]
     }
 
-    fn direction(&self, uv: [f64; 2]) -> (Vec3, f64) {
-        let (sin_phi, cos_phi) = (2.0 * PI * uv[0]).sin_cos();
-        let (sin_theta, cos_theta) = (PI * uv[1]).sin_cos();
-        let local = DVec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
-        ((self.to_world * local).normalize().as_vec3(), sin_theta)
+    /// Bilinear interpolation at (u, v) in Mitsuba's texel layout.
+    fn interpolate(&self, [u, v]: [f64; 2]) -> Vec3 {
+        let (width, height) = (self.image.width, self.image.height);
+        let x = u * width as f64 - 0.5;
+        let x0 = x.floor();
+        let fx = (x - x0) as f32;
+        let c0 = (x0 as i64).rem_euclid(width as i64) as usize;
+        let c1 = (c0 + 1) % width;
+        let y = v.clamp(0.0, 1.0) * (height - 1) as f64;
+        let r0 = (y.floor() as usize).min(height - 2);
+        let fy = (y - r0 as f64) as f32;
+        let texel = |c: usize, r: usize| Vec3::from(self.image.pixels[r * width + c]);
+        let top = texel(c0, r0).lerp(texel(c1, r0), fx);
+        let bottom = texel(c0, r0 + 1).lerp(texel(c1, r0 + 1), fx);
+        top.lerp(bottom, fy)
     }
 
-    fn texel(&self, uv: [f64; 2]) -> Vec3 {
-        let column = ((uv[0] * self.image.width as f64) as usize).min(self.image.width - 1);
-        let row = ((uv[1] * self.image.height as f64) as usize).min(self.image.height - 1);
-        Vec3::from(self.image.pixels[row * self.image.width + column])
+    /// The distribution's cell coordinates of (u, v), and the cell row's cos θ span.
+    fn cell_coordinates(&self, [u, v]: [f64; 2]) -> ([f64; 2], f64) {
+        let (width, rows) = (self.image.width as f64, self.row_cosines.len() - 1);
+        let x = (u - 0.5 / width).rem_euclid(1.0);
+        let row = ((v * rows as f64) as usize).min(rows - 1);
+        let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
+        let cos_theta = (PI * v).cos();
+        let t = ((top - cos_theta) / (top - bottom)).clamp(0.0, 1.0);
+        (
+            [x.min(1.0 - f64::EPSILON), (row as f64 + t) / rows as f64],
+            top - bottom,
+        )
+    }
+
+    /// A direction drawn from `u` and its density in solid angle.
+    fn sample(&self, u: [f64; 2]) -> (Vec3, f64) {
+        let ([x, y], pdf_cells) = self.distribution.sample(u);
+        let rows = self.row_cosines.len() - 1;
+        let row = ((y * rows as f64) as usize).min(rows - 1);
+        let t = y * rows as f64 - row as f64;
+        let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
+        let cos_theta = (top + t * (bottom - top)).clamp(-1.0, 1.0);
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (2.0 * PI * (x + 0.5 / self.image.width as f64)).sin_cos();
+        let local = DVec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
+        let direction = (self.to_world * local).normalize().as_vec3();
+        // Cells are uniform in φ and cos θ, so the density is constant within each.
+        let pdf = pdf_cells / (rows as f64 * 2.0 * PI * (top - bottom));
+        (direction, pdf)
+    }
+
+    fn pdf(&self, direction: Vec3) -> f64 {
+        let (cell, span) = self.cell_coordinates(self.uv(direction));
+        let rows = (self.row_cosines.len() - 1) as f64;
+        self.distribution.pdf(cell) / (rows * 2.0 * PI * span)
     }
 }
 
@@ -90,7 +154,7 @@ impl Environment {
     pub fn radiance(&self, direction: Vec3) -> Vec3 {
         match self {
             Environment::Constant(radiance) => *radiance,
-            Environment::Map(map) => map.texel(map.uv(direction)),
+            Environment::Map(map) => map.interpolate(map.uv(direction)),
         }
     }
 
@@ -98,16 +162,7 @@ impl Environment {
     pub fn sample(&self, u: [f32; 2]) -> (Vec3, f64) {
         match self {
             Environment::Constant(_) => (uniform_sphere(u), 1.0 / (4.0 * PI)),
-            Environment::Map(map) => {
-                let (uv, pdf_uv) = map.distribution.sample([u[0] as f64, u[1] as f64]);
-                let (direction, sin_theta) = map.direction(uv);
-                let pdf = if sin_theta > 0.0 {
-                    pdf_uv / (2.0 * PI * PI * sin_theta)
-                } else {
-                    0.0
-                };
-                (direction, pdf)
-            }
+            Environment::Map(map) => map.sample([u[0] as f64, u[1] as f64]),
         }
     }
 
@@ -115,15 +170,7 @@ impl Environment {
     pub fn pdf(&self, direction: Vec3) -> f64 {
         match self {
             Environment::Constant(_) => 1.0 / (4.0 * PI),
-            Environment::Map(map) => {
-                let uv = map.uv(direction);
-                let sin_theta = (PI * uv[1]).sin();
-                if sin_theta <= 0.0 {
-                    0.0
-                } else {
-                    map.distribution.pdf(uv) / (2.0 * PI * PI * sin_theta)
-                }
-            }
+            Environment::Map(map) => map.pdf(direction),
         }
     }
 
@@ -131,7 +178,10 @@ impl Environment {
     pub fn invert(&self, direction: Vec3) -> Option<[f64; 2]> {
         match self {
             Environment::Constant(_) => None,
-            Environment::Map(map) => Some(map.distribution.invert(map.uv(direction))),
+            Environment::Map(map) => {
+                let (cell, _) = map.cell_coordinates(map.uv(direction));
+                Some(map.distribution.invert(cell))
+            }
         }
     }
 
