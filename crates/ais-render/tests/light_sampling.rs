@@ -221,6 +221,42 @@ fn sphere_light_cone_sampling_fits() {
     assert!(p > SIGNIFICANCE, "p = {p}");
 }
 
+#[test]
+fn a_distant_sphere_light_has_density_wherever_it_brings_light() {
+    // At 120 radii the cone is 3.5e-5 wide in cos θ; a rim test in f32 once disagreed with
+    // the ray-sphere intersection, so that MIS weighted such rays by the BSDF density alone.
+    let light = AreaLight {
+        shape: AreaShape::Sphere {
+            sphere: Sphere {
+                center: Vec3::new(1.8, 2.4, 1.2),
+                radius: 0.12,
+            },
+            flipped: false,
+        },
+        radiance: Vec3::ONE,
+        shape_index: 0,
+    };
+    let point = Vec3::new(-9.0, 0.0, -9.5);
+    let mut rng = Pcg32::new(7, 3);
+    let mut brought_light = 0;
+    for _ in 0..100_000 {
+        let u = [rng.next_f32(), rng.next_f32()];
+        let Some(sample) = light.sample(point, u) else {
+            continue;
+        };
+        let ray = ais_render::geometry::Ray::new(point, sample.direction);
+        if light.intersect(&ray).is_some() {
+            brought_light += 1;
+            assert!(
+                light.pdf(point, sample.direction) > 0.0,
+                "{:?} hits the light but has no density",
+                sample.direction
+            );
+        }
+    }
+    assert!(brought_light > 99_000, "{brought_light}");
+}
+
 fn rectangle_light() -> AreaLight {
     let (a, b, c, d) = (
         Vec3::new(-0.5, -0.4, 1.0),

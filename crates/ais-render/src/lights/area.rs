@@ -163,11 +163,13 @@ impl AreaLight {
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
         match &self.shape {
             AreaShape::Sphere { sphere, .. } => {
-                let Some((axis, cos_max)) = subtended_cone(sphere, point) else {
+                let Some((_, cos_max)) = subtended_cone(sphere, point) else {
                     return 0.0;
                 };
-                let cosine = axis.dot(direction) as f64;
-                if cosine >= cos_max {
+                // The support is decided by intersecting the sphere, as radiance is: a cone
+                // test in f32 disagrees with it at the rim, and a direction that brings
+                // light but has no light density gives a huge weight (seen at 17 radii).
+                if self.intersect(&Ray::new(point, direction)).is_some() {
                     1.0 / (2.0 * PI * (1.0 - cos_max))
                 } else {
                     0.0
