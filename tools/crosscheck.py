@@ -13,7 +13,9 @@ at the same resolution. Each renderer runs `--runs` times with independent seeds
 spread of those runs gives a per-pixel standard error (SE) for both images. Reported per
 scene and ais mode:
 
-- the per-channel ratio of image means, ais / Mitsuba (threshold: within 1%);
+- the per-channel ratio of image means, ais / Mitsuba (threshold: within 1%), and the
+  largest difference of the channel means in SEs (no threshold: it tells a real offset from
+  noise);
 - relMSE = mean((ais - mitsuba)^2 / (mitsuba^2 + 0.01)) over pixels and channels
   (threshold 2e-3), and its noise floor, the part that the SEs alone explain;
 - the largest deviation of an 8x8 pixel block mean, in SEs (threshold 5);
@@ -21,8 +23,8 @@ scene and ais mode:
   false-colour PNG of that difference (blue: ais darker, red: ais brighter, saturating at
   5 SE).
 
-Exit status 1 when a threshold is exceeded, 2 for a setup problem (no Mitsuba, no ais
-binary, a scene that does not load). Mitsuba runs in a child process per scene, since
+Exit status 1 when a threshold is exceeded, 2 for a problem of ours (no ais binary, a
+scene that does not render), 3 when Mitsuba cannot be installed or imported. Mitsuba runs in a child process per scene, since
 loading a second scene in one process has been seen to deadlock.
 """
 import argparse
@@ -55,9 +57,12 @@ np.save(sys.argv[2], np.stack([np.array(mi.render(scene, seed=k, spp=spp))[..., 
 """
 
 
-def fail_setup(message):
+NO_MITSUBA = 3
+
+
+def fail_setup(message, status=2):
     print(f"crosscheck: error: {message}", file=sys.stderr)
-    sys.exit(2)
+    sys.exit(status)
 
 
 def setup_venv(venv):
@@ -73,9 +78,9 @@ def setup_venv(venv):
     for step in steps:
         done = subprocess.run(step, capture_output=True, text=True)
         if done.returncode != 0:
-            fail_setup(f"`{' '.join(step)}` failed:\n{done.stdout}{done.stderr}")
+            fail_setup(f"`{' '.join(step)}` failed:\n{done.stdout}{done.stderr}", NO_MITSUBA)
     if subprocess.run(probe, capture_output=True).returncode != 0:
-        fail_setup(f"mitsuba {MITSUBA_VERSION} does not import in {venv}")
+        fail_setup(f"mitsuba {MITSUBA_VERSION} does not import in {venv}", NO_MITSUBA)
     return python
 
 
@@ -158,6 +163,9 @@ def statistics(ours, theirs):
     rel_mse = float((difference ** 2 / denominator).mean())
     noise_floor = float((variance / denominator).mean())
     ratio = mean_ours.reshape(-1, 3).mean(0) / np.maximum(mean_theirs.reshape(-1, 3).mean(0), 1e-30)
+    # The difference of the image means in SEs: is a ratio's offset noise or a real difference?
+    mean_z = difference.reshape(-1, 3).mean(0) / np.sqrt((variance + floor).reshape(-1, 3).sum(0)) * \
+        difference.shape[0] * difference.shape[1]
     height, width = difference.shape[:2]
     worst = (0.0, None)
     for y in range(0, height, BLOCK):
@@ -175,6 +183,7 @@ def statistics(ours, theirs):
     z_sum = (sums_ours.mean(0) - sums_theirs.mean(0)) / np.sqrt(sum_variance + floor.sum(-1))
     return {
         "mean_ratio": [float(r) for r in ratio],
+        "mean_difference_se": [float(z) for z in mean_z],
         "rel_mse": rel_mse,
         "rel_mse_noise_floor": noise_floor,
         "worst_block_se": worst[0],
@@ -251,6 +260,7 @@ def main():
                         help="the ais binary")
     parser.add_argument("--out", default=os.path.join(ROOT, "target", "crosscheck"),
                         help="folder for the images and summary.json")
+    parser.add_argument("--markdown", action="store_true", help="also print the results as a Markdown table")
     args = parser.parse_args()
 
     if args.setup:
@@ -265,7 +275,7 @@ def main():
         import mitsuba
     except ImportError as e:
         fail_setup(f"{e}; run `python3 tools/crosscheck.py --setup` (makes .venv with "
-                   f"mitsuba=={MITSUBA_VERSION} and numpy) or `pip install mitsuba numpy`")
+                   f"mitsuba=={MITSUBA_VERSION} and numpy) or `pip install mitsuba numpy`", NO_MITSUBA)
     mitsuba.set_variant("scalar_rgb")
     scenes = args.scenes + (suite_scenes() if args.suite else [])
     if not scenes:
@@ -284,7 +294,7 @@ def main():
           f"{args.mitsuba_samples} samples) vs ais gather mis n={args.rays}; {width}x{height}, "
           f"{args.spp} spp in {args.runs} runs each")
     header = f"{'scene':<28} {'ais':<11} {'R ratio':>8} {'G ratio':>8} {'B ratio':>8} " \
-             f"{'relMSE':>9} {'(noise)':>9} {'block SE':>9}  verdict"
+             f"{'mean SE':>8} {'relMSE':>9} {'(noise)':>9} {'block SE':>9}  verdict"
     print(header)
     summary, failed = [], []
     for scene in scenes:
@@ -305,7 +315,8 @@ def main():
                 save(stem + "-se.exr", stats["z"])
                 save(stem + "-se.png", false_colour(stats["z_sum"]))
                 r, g, b = stats["mean_ratio"]
-                print(f"{name:<28} {mode:<11} {r:8.4f} {g:8.4f} {b:8.4f} {stats['rel_mse']:9.2e} "
+                mean_se = max(stats["mean_difference_se"], key=abs)
+                print(f"{name:<28} {mode:<11} {r:8.4f} {g:8.4f} {b:8.4f} {mean_se:+8.2f} {stats['rel_mse']:9.2e} "
                       f"{stats['rel_mse_noise_floor']:9.2e} {stats['worst_block_se']:+9.2f}  "
                       f"{'ok' if not failures else 'FAIL'}", flush=True)
                 for failure in failures:
@@ -320,6 +331,15 @@ def main():
                    "mitsuba_samples": args.mitsuba_samples, "results": summary}, f, indent=1)
     os.replace(os.path.join(args.out, "summary.json.part"), os.path.join(args.out, "summary.json"))
     print(f"crosscheck: images and summary.json in {args.out}")
+    if args.markdown:
+        print("\n| scene | ais AIS | R, G, B mean ratio | mean SE | relMSE | noise | block SE |")
+        print("|---|---|---|---|---|---|---|")
+        for row in summary:
+            scene = os.path.splitext(os.path.relpath(row["scene"], "scenes"))[0]
+            ratios = ", ".join(f"{r:.4f}" for r in row["mean_ratio"])
+            mean_se = max(row["mean_difference_se"], key=abs)
+            print(f"| {scene} | {row['mode']} | {ratios} | {mean_se:+.2f} | {row['rel_mse']:.2e} | "
+                  f"{row['rel_mse_noise_floor']:.2e} | {row['worst_block_se']:+.2f} |")
     if failed:
         print(f"crosscheck: {len(failed)} threshold(s) exceeded:", file=sys.stderr)
         for line in failed:

@@ -115,6 +115,64 @@ fn rgb(plugin: &Plugin, name: &str, default: Vec3) -> Result<Vec3, String> {
     }
 }
 
+/// An index of refraction given as a number or by name (the names Mitsuba accepts).
+fn index_of_refraction(
+    plugin: &Plugin,
+    name: &str,
+    default: f64,
+    warn: &mut dyn FnMut(String),
+) -> f64 {
+    match plugin.properties.get(name).map(|p| &p.value) {
+        None => default,
+        Some(Property::Float(v)) if *v > 0.0 => *v,
+        Some(Property::String(material)) => match named_index_of_refraction(material) {
+            Some(v) => v,
+            None => {
+                warn(format!(
+                    "\"{name}\": unknown material \"{material}\"; using {default}"
+                ));
+                default
+            }
+        },
+        Some(other) => {
+            warn(format!(
+                "\"{name}\" must be a positive float or a material name, not {other:?}; using {default}"
+            ));
+            default
+        }
+    }
+}
+
+/// Indices of refraction of common dielectrics at about 589 nm.
+fn named_index_of_refraction(material: &str) -> Option<f64> {
+    Some(match material.to_ascii_lowercase().as_str() {
+        "vacuum" => 1.0,
+        "helium" => 1.00004,
+        "hydrogen" => 1.00013,
+        "air" => 1.000277,
+        "carbon dioxide" => 1.00045,
+        "water" => 1.333,
+        "acetone" => 1.36,
+        "ethanol" => 1.361,
+        "carbon tetrachloride" => 1.461,
+        "glycerol" => 1.4729,
+        "benzene" => 1.501,
+        "silicone oil" => 1.52045,
+        "bromine" => 1.661,
+        "water ice" => 1.31,
+        "fused quartz" => 1.458,
+        "pyrex" => 1.47,
+        "acrylic glass" => 1.49,
+        "polypropylene" => 1.49,
+        "bk7" => 1.5046,
+        "sodium chloride" => 1.544,
+        "amber" => 1.55,
+        "pet" => 1.575,
+        "diamond" => 2.419,
+        _ => return None,
+    })
+}
+
 impl Material {
     /// One-sided diffuse of albedo `reflectance`.
     pub fn diffuse(reflectance: Vec3) -> Self {
@@ -222,8 +280,8 @@ impl Material {
             }
             "roughplastic" => {
                 let microfacet = microfacet(&mut warn);
-                let int_ior = plugin.float("int_ior", 1.49).unwrap_or(1.49);
-                let ext_ior = plugin.float("ext_ior", 1.000277).unwrap_or(1.000277);
+                let int_ior = index_of_refraction(plugin, "int_ior", 1.49, &mut warn);
+                let ext_ior = index_of_refraction(plugin, "ext_ior", 1.000277, &mut warn);
                 let diffuse = checked(
                     rgb(plugin, "diffuse_reflectance", Vec3::splat(0.5)),
                     &mut warn,
@@ -388,7 +446,7 @@ mod tests {
         let (m, warnings) = materials(
             r#"<bsdf type="roughconductor" id="a"><float name="alpha" value="0.3"/><string name="material" value="Au"/></bsdf>
                <bsdf type="roughconductor" id="b"/>
-               <bsdf type="roughplastic" id="c"><rgb name="diffuse_reflectance" value="0.2, 0.4, 0.6"/><float name="int_ior" value="1.5"/></bsdf>
+               <bsdf type="roughplastic" id="c"><rgb name="diffuse_reflectance" value="0.2, 0.4, 0.6"/><float name="int_ior" value="1.5"/><string name="ext_ior" value="air"/></bsdf>
                <bsdf type="twosided" id="d"><bsdf type="diffuse"><float name="reflectance" value="0.3"/></bsdf></bsdf>"#,
         );
         assert!(warnings.is_empty(), "{warnings:?}");
@@ -424,7 +482,8 @@ mod tests {
     fn unsupported_bsdfs_and_properties_warn() {
         let (m, warnings) = materials(
             r#"<bsdf type="dielectric" id="a"/>
-               <bsdf type="roughconductor" id="b"><string name="material" value="Unobtainium"/><float name="alpha_u" value="0.1"/></bsdf>"#,
+               <bsdf type="roughconductor" id="b"><string name="material" value="Unobtainium"/><float name="alpha_u" value="0.1"/></bsdf>
+               <bsdf type="roughplastic" id="c"><string name="int_ior" value="kryptonite"/></bsdf>"#,
         );
         assert_eq!(m[0], Material::default());
         let all = warnings.join("\n");
@@ -433,7 +492,7 @@ mod tests {
             "{all}"
         );
         assert!(
-            all.contains("Unobtainium") && all.contains("alpha_u"),
+            all.contains("Unobtainium") && all.contains("alpha_u") && all.contains("kryptonite"),
             "{all}"
         );
     }
