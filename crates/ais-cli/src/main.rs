@@ -14,6 +14,8 @@ use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+mod compare;
+
 /// Adaptive importance sampling for multi-ray gathering: a renderer for studying it.
 #[derive(Parser)]
 #[command(name = "ais", version, about)]
@@ -28,6 +30,9 @@ enum Command {
     Render(Box<RenderArgs>),
     /// Measure BVH build time and ray throughput on the built-in default scene.
     Bench(BenchArgs),
+    /// Compare gather configurations (the talk's by default) at equal time and equal rays
+    /// against a converged reference, and write an HTML report.
+    Compare(Box<compare::CompareArgs>),
 }
 
 #[derive(clap::Args)]
@@ -102,7 +107,8 @@ struct RenderArgs {
     /// Gather proposal: uniform, bsdf, light or mis.
     #[arg(long)]
     strategy: Option<String>,
-    /// AIS mode: off, aggressive or conservative.
+    /// AIS mode: off, aggressive, conservative, or oracle (a bound for studies: the proposal
+    /// restricted to directions that bring light, found by free brute-force tests).
     #[arg(long)]
     ais: Option<String>,
     /// Rays per gather (n).
@@ -144,10 +150,21 @@ struct RenderArgs {
     define: Vec<(String, String)>,
 }
 
+/// Gather flags given on the command line (None: not given).
+#[derive(Default)]
+struct GatherFlags {
+    strategy: Option<String>,
+    ais: Option<String>,
+    placement: Option<String>,
+    rays: Option<u32>,
+    tol: Option<f32>,
+    map_res: Option<u32>,
+}
+
 /// Gather settings: defaults, then the scene's `<integrator type="gather">` properties,
 /// then command-line flags.
 fn gather_settings(
-    args: &RenderArgs,
+    args: &GatherFlags,
     plugin: Option<&ais_render::scene::Plugin>,
 ) -> Result<GatherSettings, String> {
     let mut settings = GatherSettings::default();
@@ -175,7 +192,7 @@ fn gather_settings(
     }
     if let Some(name) = ais {
         settings.ais = AisMode::parse(&name).ok_or_else(|| {
-            format!("unknown AIS mode \"{name}\" (off, aggressive, conservative)")
+            format!("unknown AIS mode \"{name}\" (off, aggressive, conservative, oracle)")
         })?;
     }
     if let Some(name) = &args.placement {
@@ -220,8 +237,9 @@ fn parse_define(text: &str) -> Result<(String, String), String> {
     Ok((name.to_string(), value.to_string()))
 }
 
-fn run_render(args: RenderArgs) -> Result<(), String> {
-    if let Some(threads) = args.threads {
+/// Starts `threads` rayon workers (None: one per core).
+fn start_threads(threads: Option<usize>) -> Result<(), String> {
+    if let Some(threads) = threads {
         if threads == 0 {
             return Err("--threads must be at least 1".into());
         }
@@ -230,6 +248,38 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             .build_global()
             .map_err(|e| format!("cannot start {threads} threads: {e}"))?;
     }
+    Ok(())
+}
+
+/// The scene file's world (resolution overridden if given), or the built-in default scene at
+/// `resolution` or `default_resolution`; prints the scene's warnings.
+fn load_world(
+    scene: Option<&std::path::Path>,
+    defines: &[(String, String)],
+    resolution: Option<(u32, u32)>,
+    default_resolution: (u32, u32),
+) -> Result<World, String> {
+    let world = match scene {
+        Some(path) => {
+            let mut description = load_scene(path, defines).map_err(|e| e.to_string())?;
+            if let Some(resolution) = resolution {
+                description.resolution = resolution;
+            }
+            World::from_description(description).map_err(|e| e.to_string())?
+        }
+        None => {
+            let (width, height) = resolution.unwrap_or(default_resolution);
+            default_world(width, height)
+        }
+    };
+    for warning in &world.warnings {
+        eprintln!("warning: {warning}");
+    }
+    Ok(world)
+}
+
+fn run_render(args: RenderArgs) -> Result<(), String> {
+    start_threads(args.threads)?;
     let extension = args
         .output
         .extension()
@@ -241,22 +291,12 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             args.output.display()
         ));
     }
-    let world = match &args.scene {
-        Some(path) => {
-            let mut description = load_scene(path, &args.define).map_err(|e| e.to_string())?;
-            if let Some(resolution) = args.resolution {
-                description.resolution = resolution;
-            }
-            World::from_description(description).map_err(|e| e.to_string())?
-        }
-        None => {
-            let (width, height) = args.resolution.unwrap_or((640, 360));
-            default_world(width, height)
-        }
-    };
-    for warning in &world.warnings {
-        eprintln!("warning: {warning}");
-    }
+    let world = load_world(
+        args.scene.as_deref(),
+        &args.define,
+        args.resolution,
+        (640, 360),
+    )?;
     let scene_integrator = world.description.integrator.clone();
     let choice = match (args.integrator, &scene_integrator) {
         (Some(choice), _) => choice,
@@ -282,7 +322,15 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
     };
     let integrator = match choice {
         IntegratorChoice::Gather => {
-            Integrator::Gather(gather_settings(&args, scene_integrator.as_ref())?)
+            let flags = GatherFlags {
+                strategy: args.strategy.clone(),
+                ais: args.ais.clone(),
+                placement: args.placement.clone(),
+                rays: args.rays,
+                tol: args.tol,
+                map_res: args.map_res,
+            };
+            Integrator::Gather(gather_settings(&flags, scene_integrator.as_ref())?)
         }
         IntegratorChoice::Normals => Integrator::Normals,
         IntegratorChoice::Ao => {
@@ -381,6 +429,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Render(args) => run_render(*args),
         Command::Bench(args) => run_bench(args),
+        Command::Compare(args) => compare::run(*args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,9 +1,11 @@
 //! The multi-ray gather integrator: direct light at the first hit, gathered with `n` rays
 //! through the AIS batch driver from a proposal strategy.
 
+use crate::ais_timer::AisTimer;
 use crate::bsdf::ShadingFrame;
+use crate::geometry::Hit;
 use crate::geometry::{spawn_ray, Ray};
-use crate::integrator::SampleContext;
+use crate::integrator::{RayCounts, SampleContext};
 use crate::lights::luminance;
 use crate::proposal::{GatherPoint, Strategy};
 use crate::world::World;
@@ -20,6 +22,10 @@ pub enum AisMode {
     Aggressive,
     /// The talk's conservative map (shadow-edge resets).
     Conservative,
+    /// Not a technique but a bound for studies: the same proposal restricted to the
+    /// directions that bring light, found by tracing every candidate for free
+    /// (see [`crate::oracle`]).
+    Oracle,
 }
 
 impl AisMode {
@@ -29,6 +35,7 @@ impl AisMode {
             "off" => Some(AisMode::Off),
             "aggressive" => Some(AisMode::Aggressive),
             "conservative" => Some(AisMode::Conservative),
+            "oracle" => Some(AisMode::Oracle),
             _ => None,
         }
     }
@@ -77,7 +84,7 @@ impl GatherSettings {
             ..BatchConfig::default()
         };
         match self.ais {
-            AisMode::Off => BatchConfig {
+            AisMode::Off | AisMode::Oracle => BatchConfig {
                 affinity: None,
                 learning: ais::Learning::Off,
                 ..base
@@ -96,6 +103,42 @@ impl GatherSettings {
                 ..base
             },
         }
+    }
+}
+
+/// Radiance arriving at the gather point from `direction`: (actual, unoccluded). Only rays
+/// that could bring light are traced (and counted).
+pub(crate) fn light_along(
+    world: &World,
+    at: &GatherPoint,
+    direction: Vec3,
+    counts: &mut RayCounts,
+) -> (Vec3, Vec3) {
+    let mut leaving = spawn_ray(at.point, at.frame.geometric, direction);
+    let (unoccluded, distance) = world.lights.unoccluded(&leaving);
+    // The emitter's own surface is in the BVH: stop just short of it. A ray whose
+    // unoccluded radiance is zero brings zero whatever blocks it: no need to trace.
+    if unoccluded == Vec3::ZERO {
+        return (Vec3::ZERO, Vec3::ZERO);
+    }
+    leaving.t_max = distance * (1.0 - 1e-4);
+    counts.occlusion += 1;
+    if world.geometry.occluded(&leaving) {
+        (Vec3::ZERO, unoccluded)
+    } else {
+        (unoccluded, unoccluded)
+    }
+}
+
+/// The gather point where `hit` is seen from direction `wo` (pointing away from it).
+pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a> {
+    let material = &world.materials[hit.shape as usize];
+    GatherPoint {
+        point: hit.point,
+        frame: ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo),
+        wo,
+        material,
+        lights: &world.lights,
     }
 }
 
@@ -118,62 +161,71 @@ pub fn gather(
     if world.lights.is_empty() {
         return emitted;
     }
-    let wo = -ray.direction;
-    let material = &world.materials[hit.shape as usize];
-    let frame = ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo);
-    let at = GatherPoint {
-        point: hit.point,
-        frame,
-        wo,
-        material,
-        lights: &world.lights,
-    };
+    let at = gather_point(world, &hit, -ray.direction);
+    if settings.ais == AisMode::Oracle {
+        return emitted
+            + crate::oracle::gather_with_oracle(world, settings, &at, rng, &mut context.counts);
+    }
     let SampleContext {
         counts,
         batch,
-        ais_timer: timer,
+        ais_timer,
     } = context;
     let batch = batch.get_or_insert_with(|| {
         Batch::new(settings.batch_config()).expect("valid gather configuration")
     });
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+    emitted
+        + run_batch(
+            world,
+            settings,
+            &at,
+            batch,
+            seed,
+            counts,
+            ais_timer,
+            &mut |_| {},
+        )
+}
+
+/// One batch of `settings.rays` rays at `at` through `batch` (configured for `settings`,
+/// or a variant of it); `observe` sees the batch after every traced candidate.
+#[allow(clippy::too_many_arguments)]
+pub fn run_batch(
+    world: &World,
+    settings: &GatherSettings,
+    at: &GatherPoint,
+    batch: &mut Batch<[f32; 3]>,
+    seed: u64,
+    counts: &mut RayCounts,
+    timer: &mut AisTimer,
+    observe: &mut dyn FnMut(&Batch<[f32; 3]>),
+) -> Vec3 {
+    let (frame, wo, material) = (&at.frame, at.wo, at.material);
     timer.start_gather();
     batch.begin(settings.rays, seed, MapStart::Empty);
     while let Some(candidate) = batch.next_candidate() {
         let Some((direction, pdf)) = settings
             .strategy
-            .sample(&at, candidate.u)
+            .sample(at, candidate.u)
             .filter(|s| s.1 > 0.0)
         else {
             timer.decided(frame.normal, false);
             batch.decide(frame.normal, false);
             continue;
         };
-        let in_support = material.in_support(&frame, wo, direction);
+        let in_support = material.in_support(frame, wo, direction);
         timer.decided(direction, in_support);
         if let Decision::Trace { .. } = batch.decide(direction, in_support) {
-            let mut leaving = spawn_ray(hit.point, frame.geometric, direction);
-            let (unoccluded, distance) = world.lights.unoccluded(&leaving);
-            // The emitter's own surface is in the BVH: stop just short of it. A ray whose
-            // unoccluded radiance is zero brings zero whatever blocks it: no need to trace.
-            let actual = if unoccluded == Vec3::ZERO {
-                Vec3::ZERO
-            } else {
-                leaving.t_max = distance * (1.0 - 1e-4);
-                counts.occlusion += 1;
-                if world.geometry.occluded(&leaving) {
-                    Vec3::ZERO
-                } else {
-                    unoccluded
-                }
-            };
-            let value = material.eval(&frame, wo, direction) * actual / pdf as f32;
+            let (actual, unoccluded) = light_along(world, at, direction, counts);
+            let value = material.eval(frame, wo, direction) * actual / pdf as f32;
             let rating = rating(luminance(actual), luminance(unoccluded));
             timer.recorded(value.to_array(), rating);
             batch.record(value.to_array(), rating);
+            observe(batch);
         }
     }
     let estimate = batch.finish();
     timer.end_gather(batch.config(), settings.rays, seed);
-    emitted + Vec3::from(estimate.value)
+    Vec3::from(estimate.value)
 }

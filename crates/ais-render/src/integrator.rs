@@ -14,6 +14,8 @@ pub struct RayCounts {
     pub closest_hit: u64,
     /// Occlusion (any-hit) queries.
     pub occlusion: u64,
+    /// Visibility tests the oracle made for free (studies only; not in [`RayCounts::total`]).
+    pub oracle_tests: u64,
 }
 
 impl RayCounts {
@@ -21,6 +23,7 @@ impl RayCounts {
     pub fn merge(&mut self, other: RayCounts) {
         self.closest_hit += other.closest_hit;
         self.occlusion += other.occlusion;
+        self.oracle_tests += other.oracle_tests;
     }
 
     /// All rays.

@@ -22,10 +22,12 @@ pub mod image_io;
 pub mod integrator;
 pub mod lights;
 pub mod mesh;
+pub mod oracle;
 pub mod proposal;
 pub mod render;
 pub mod scene;
 pub mod shapes;
+pub mod study;
 pub mod world;
 
 pub use error::InputError;

@@ -17,7 +17,12 @@ const STRATEGIES: [Strategy; 4] = [
     Strategy::Light,
     Strategy::Mis,
 ];
-const MODES: [AisMode; 3] = [AisMode::Off, AisMode::Aggressive, AisMode::Conservative];
+const MODES: [AisMode; 4] = [
+    AisMode::Off,
+    AisMode::Aggressive,
+    AisMode::Conservative,
+    AisMode::Oracle,
+];
 
 fn world(name: &str, xml: &str, files: &[(&str, &str)]) -> World {
     let dir = common::scratch(name);

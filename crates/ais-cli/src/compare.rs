@@ -1,0 +1,211 @@
+//! `ais compare`: a study of gather configurations on one scene, with an HTML report.
+
+use crate::{
+    gather_settings, load_world, parse_define, parse_resolution, start_threads, GatherFlags,
+};
+use ais_render::gather::{AisMode, GatherSettings};
+use ais_render::proposal::Strategy;
+use ais_render::study::report::{self, ReportContext};
+use ais_render::study::{reference, talk_configurations, Configuration, StudySettings};
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Duration;
+
+#[derive(clap::Args)]
+pub struct CompareArgs {
+    /// The scene file (Mitsuba 3 XML). Omit it to study the built-in default scene.
+    scene: Option<PathBuf>,
+    /// The report's folder (index.html, tables.md, images/, cache/).
+    #[arg(short, long, default_value = "report")]
+    output: PathBuf,
+    /// Wall time of each equal-time run, in seconds.
+    #[arg(long, default_value_t = 3.0)]
+    time_budget: f64,
+    /// Independent runs per configuration and budget (for error bars).
+    #[arg(long, default_value_t = 3)]
+    seeds: u32,
+    /// Proposals to compare (uniform, bsdf, light, mis); with --ais, replaces the talk's set
+    /// of configurations by every strategy × AIS mode (and the oracle).
+    #[arg(long, value_delimiter = ',')]
+    strategies: Vec<String>,
+    /// AIS modes to compare (off, aggressive, conservative); see --strategies.
+    #[arg(long, value_delimiter = ',')]
+    ais: Vec<String>,
+    /// Rays per gather (n).
+    #[arg(long)]
+    rays: Option<u32>,
+    /// Affinity-map tol.
+    #[arg(long)]
+    tol: Option<f32>,
+    /// Affinity-map height in texels.
+    #[arg(long)]
+    map_res: Option<u32>,
+    /// Film size (default: the scene's; 320x180 for the default scene).
+    #[arg(long, value_parser = parse_resolution)]
+    resolution: Option<(u32, u32)>,
+    /// Samples per pixel of the reference (cached in the report's cache/ folder).
+    #[arg(long, default_value_t = 256)]
+    reference_spp: u32,
+    /// The pixel of the affinity-map figure, x,y (default: the image centre).
+    #[arg(long, value_parser = parse_pixel)]
+    pixel: Option<(u32, u32)>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bars.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Set a scene $parameter: -D name=value (repeatable).
+    #[arg(short = 'D', value_parser = parse_define)]
+    define: Vec<(String, String)>,
+}
+
+fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
+    let (x, y) = text
+        .split_once(',')
+        .ok_or_else(|| format!("\"{text}\" is not x,y"))?;
+    let parse = |s: &str| {
+        s.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("\"{s}\" is not a pixel coordinate"))
+    };
+    Ok((parse(x)?, parse(y)?))
+}
+
+/// The configurations: the talk's, or every given strategy × AIS mode plus the oracle.
+fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Configuration>, String> {
+    if args.strategies.is_empty() && args.ais.is_empty() {
+        return Ok(talk_configurations(base));
+    }
+    let strategies = if args.strategies.is_empty() {
+        vec!["mis".to_string()]
+    } else {
+        args.strategies.clone()
+    };
+    let modes = if args.ais.is_empty() {
+        vec!["off".to_string(), "aggressive".to_string()]
+    } else {
+        args.ais.clone()
+    };
+    let mut list = Vec::new();
+    for strategy_name in &strategies {
+        let strategy = Strategy::parse(strategy_name).ok_or_else(|| {
+            format!("unknown strategy \"{strategy_name}\" (uniform, bsdf, light, mis)")
+        })?;
+        for mode_name in &modes {
+            let ais = AisMode::parse(mode_name)
+                .filter(|m| *m != AisMode::Oracle)
+                .ok_or_else(|| {
+                    format!("unknown AIS mode \"{mode_name}\" (off, aggressive, conservative)")
+                })?;
+            let name = format!("{strategy_name}-{mode_name}");
+            list.push(Configuration::new(
+                &name,
+                &name,
+                GatherSettings {
+                    strategy,
+                    ais,
+                    ..base
+                },
+            ));
+        }
+    }
+    let first = list[0].settings;
+    list.push(Configuration::new(
+        &format!("{}-oracle", strategies[0]),
+        "oracle: the first strategy restricted to directions that bring light",
+        GatherSettings {
+            ais: AisMode::Oracle,
+            placement: ais::Placement::Random,
+            ..first
+        },
+    ));
+    Ok(list)
+}
+
+pub fn run(args: CompareArgs) -> Result<(), String> {
+    start_threads(args.threads)?;
+    if !(args.time_budget > 0.0 && args.time_budget.is_finite()) {
+        return Err("--time-budget must be a positive number of seconds".into());
+    }
+    if args.seeds == 0 || args.reference_spp == 0 {
+        return Err("--seeds and --reference-spp must be at least 1".into());
+    }
+    let world = load_world(
+        args.scene.as_deref(),
+        &args.define,
+        args.resolution,
+        (320, 180),
+    )?;
+    let flags = GatherFlags {
+        rays: args.rays,
+        tol: args.tol,
+        map_res: args.map_res,
+        ..GatherFlags::default()
+    };
+    let base = gather_settings(&flags, world.description.integrator.as_ref())?;
+    let (width, height) = world.resolution;
+    let pixel = args.pixel.unwrap_or((width / 2, height / 2));
+    if pixel.0 >= width || pixel.1 >= height {
+        return Err(format!(
+            "--pixel {},{} is outside the {width}×{height} image",
+            pixel.0, pixel.1
+        ));
+    }
+    // The reference depends on the scene, its size and the reference settings.
+    let scene_identity = match &args.scene {
+        Some(path) => {
+            let bytes = std::fs::read(path)
+                .map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?;
+            format!("{:016x}", reference::fnv1a(&bytes))
+        }
+        None => "built-in default scene".into(),
+    };
+    let key = format!(
+        "{scene_identity}|{:?}|{width}x{height}|{}|{}|{}|{}",
+        args.define,
+        args.reference_spp,
+        base.rays,
+        env!("CARGO_PKG_VERSION"),
+        "reference v2"
+    );
+    let settings = StudySettings {
+        configurations: configurations(&args, base)?,
+        time_budget: Duration::from_secs_f64(args.time_budget),
+        seeds: args.seeds,
+        reference_spp: args.reference_spp,
+        reference_cache: Some(reference::cache_paths(&args.output.join("cache"), &key)),
+        figure_pixel: pixel,
+        progress: !args.quiet && std::io::stderr().is_terminal(),
+    };
+    let runs = settings.configurations.len() * 2 - 1;
+    if !args.quiet {
+        eprintln!(
+            "studying {} configurations × {} seeds (about {:.0} s after the reference)…",
+            settings.configurations.len(),
+            args.seeds,
+            runs as f64 * args.seeds as f64 * args.time_budget
+        );
+    }
+    let results = ais_render::study::run(&world, &settings)?;
+    let scene_name = args
+        .scene
+        .as_ref()
+        .map_or("the built-in default scene".into(), |p| {
+            p.display().to_string()
+        });
+    let context = ReportContext {
+        scene: &scene_name,
+        resolution: world.resolution,
+        rays: base.rays,
+        time_budget: args.time_budget,
+        seeds: args.seeds,
+        reference_spp: args.reference_spp,
+        threads: rayon::current_num_threads(),
+        figure_pixel: pixel,
+    };
+    let path = report::write(&args.output, &results, &context)?;
+    println!("{}", report::markdown_tables(&results, &context));
+    println!("report       {}", path.display());
+    Ok(())
+}

@@ -1,0 +1,375 @@
+//! Studies (`ais compare`): configurations of the gather rendered against a converged
+//! reference at equal wall time and at equal traced rays, with several seeds, and a
+//! self-contained HTML report.
+//!
+//! Each run renders progressive passes of one sample per pixel until its budget is spent,
+//! recording relMSE after every pass (the convergence curves). Equal-time runs stop at the
+//! time budget; equal-ray runs stop when they have traced as many rays (camera plus gather
+//! rays) as the baseline configuration traced in its equal-time runs (median over seeds).
+//! The oracle runs at equal rays only: its free visibility tests make its time meaningless.
+
+pub mod affinity_figure;
+pub mod metrics;
+pub mod plots;
+pub mod reference;
+pub mod report;
+
+use crate::gather::{AisMode, GatherSettings};
+use crate::image_io::RgbImage;
+use crate::integrator::{Integrator, RayCounts};
+use crate::proposal::Strategy;
+use crate::render::{render, RenderSettings};
+use crate::world::World;
+use ais::rng::mix64;
+use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
+use std::path::Path;
+use std::time::Duration;
+
+/// Most passes of a run, whatever its budget.
+const MOST_PASSES: u32 = 1 << 14;
+
+/// One configuration of the gather under study.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Configuration {
+    /// Short name, also used in file names.
+    pub name: String,
+    /// What the talk would call it, for figures.
+    pub label: String,
+    /// The gather's settings.
+    pub settings: GatherSettings,
+}
+
+impl Configuration {
+    /// A configuration named after its settings.
+    pub fn new(name: &str, label: &str, settings: GatherSettings) -> Self {
+        Configuration {
+            name: name.into(),
+            label: label.into(),
+            settings,
+        }
+    }
+
+    /// Whether this is the oracle (run at equal rays only).
+    pub fn is_oracle(&self) -> bool {
+        self.settings.ais == AisMode::Oracle
+    }
+}
+
+/// The talk's comparison on top of `base`: uniform, the importance sampler without and with
+/// AIS (aggressive, conservative), random against Halton placement, and the oracle.
+pub fn talk_configurations(base: GatherSettings) -> Vec<Configuration> {
+    let with = |strategy, ais, placement| GatherSettings {
+        strategy,
+        ais,
+        placement,
+        ..base
+    };
+    use ais::Placement::{Halton, Random};
+    vec![
+        Configuration::new(
+            "mis-off",
+            "PHIS (MIS), AIS off",
+            with(Strategy::Mis, AisMode::Off, Halton),
+        ),
+        Configuration::new(
+            "uniform-off",
+            "Uniform",
+            with(Strategy::Uniform, AisMode::Off, Halton),
+        ),
+        Configuration::new(
+            "mis-aggressive",
+            "PHIS + AIS aggressive",
+            with(Strategy::Mis, AisMode::Aggressive, Halton),
+        ),
+        Configuration::new(
+            "mis-conservative",
+            "PHIS + AIS conservative",
+            with(Strategy::Mis, AisMode::Conservative, Halton),
+        ),
+        Configuration::new(
+            "mis-off-random",
+            "PHIS, random placement",
+            with(Strategy::Mis, AisMode::Off, Random),
+        ),
+        Configuration::new(
+            "mis-aggressive-random",
+            "PHIS + AIS aggressive, random placement",
+            with(Strategy::Mis, AisMode::Aggressive, Random),
+        ),
+        Configuration::new(
+            "mis-oracle",
+            "PHIS restricted to visible directions (oracle)",
+            with(Strategy::Mis, AisMode::Oracle, Random),
+        ),
+    ]
+}
+
+/// How a study runs.
+#[derive(Clone, Debug)]
+pub struct StudySettings {
+    /// Configurations; the first is the baseline of the ratios.
+    pub configurations: Vec<Configuration>,
+    /// Wall time of each equal-time run.
+    pub time_budget: Duration,
+    /// Independent runs per configuration and budget.
+    pub seeds: u32,
+    /// Samples per pixel of the reference (MIS, AIS off).
+    pub reference_spp: u32,
+    /// Where the reference's two halves are cached (None: not cached).
+    pub reference_cache: Option<[std::path::PathBuf; 2]>,
+    /// The pixel of the affinity-map figure.
+    pub figure_pixel: (u32, u32),
+    /// Show progress bars.
+    pub progress: bool,
+}
+
+/// relMSE after a pass (less the reference's own noise), with what it cost.
+#[derive(Clone, Copy, Debug)]
+pub struct CurvePoint {
+    /// Render time so far (seconds).
+    pub seconds: f64,
+    /// Rays traced so far (camera and gather rays).
+    pub rays: u64,
+    /// relMSE of the image so far.
+    pub rel_mse: f64,
+}
+
+/// One progressive run.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// The final image.
+    pub image: RgbImage,
+    /// Samples per pixel reached.
+    pub spp: u32,
+    /// Render time (seconds).
+    pub seconds: f64,
+    /// Rays traced.
+    pub rays: RayCounts,
+    /// AIS statistics.
+    pub stats: ais::Stats,
+    /// relMSE after every pass.
+    pub curve: Vec<CurvePoint>,
+}
+
+impl Run {
+    /// The final relMSE.
+    pub fn rel_mse(&self) -> f64 {
+        self.curve.last().map_or(f64::NAN, |p| p.rel_mse)
+    }
+}
+
+/// A configuration's runs.
+#[derive(Clone, Debug)]
+pub struct ConfigurationResult {
+    /// What was run.
+    pub configuration: Configuration,
+    /// Equal-time runs, one per seed (empty for the oracle).
+    pub equal_time: Vec<Run>,
+    /// Equal-ray runs, one per seed.
+    pub equal_rays: Vec<Run>,
+}
+
+/// Everything a study measured.
+#[derive(Clone, Debug)]
+pub struct StudyResults {
+    /// The reference.
+    pub reference: reference::Reference,
+    /// The ray budget of the equal-ray runs.
+    pub ray_budget: u64,
+    /// Per configuration, in the order given.
+    pub results: Vec<ConfigurationResult>,
+    /// The affinity-map figure's snapshots (None: the pixel sees no gather).
+    pub figure: Option<Vec<affinity_figure::MapSnapshot>>,
+}
+
+/// Mean and standard error of the mean.
+pub fn mean_and_error(values: &[f64]) -> (f64, f64) {
+    let n = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / n;
+    if values.len() < 2 {
+        return (mean, f64::NAN);
+    }
+    let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (variance / n).sqrt())
+}
+
+/// When a progressive run stops.
+#[derive(Clone, Copy, Debug)]
+enum Budget {
+    Seconds(f64),
+    Rays(u64),
+}
+
+fn progressive(
+    world: &World,
+    settings: GatherSettings,
+    reference: &reference::Reference,
+    seed: u64,
+    budget: Budget,
+) -> Run {
+    let pixels = reference.image.pixels.len();
+    let mut sum = vec![[0.0f64; 3]; pixels];
+    let mut run = Run {
+        image: reference.image.clone(),
+        spp: 0,
+        seconds: 0.0,
+        rays: RayCounts::default(),
+        stats: ais::Stats::default(),
+        curve: Vec::new(),
+    };
+    loop {
+        let output = render(
+            world,
+            &RenderSettings {
+                samples_per_pixel: 1,
+                integrator: Integrator::Gather(settings),
+                seed: mix64(seed ^ mix64(run.spp as u64 + 1)),
+                progress: false,
+            },
+        );
+        for (s, p) in sum.iter_mut().zip(&output.image.pixels) {
+            for c in 0..3 {
+                s[c] += p[c] as f64;
+            }
+        }
+        run.spp += 1;
+        run.seconds += output.time.as_secs_f64();
+        run.rays.merge(output.rays);
+        run.stats.merge(&output.ais);
+        for (pixel, s) in run.image.pixels.iter_mut().zip(&sum) {
+            *pixel = s.map(|v| (v / run.spp as f64) as f32);
+        }
+        run.curve.push(CurvePoint {
+            seconds: run.seconds,
+            rays: run.rays.total(),
+            rel_mse: reference.rel_mse(&run.image),
+        });
+        let spent = match budget {
+            Budget::Seconds(limit) => run.seconds >= limit,
+            Budget::Rays(limit) => run.rays.total() >= limit,
+        };
+        if spent || run.spp >= MOST_PASSES {
+            return run;
+        }
+    }
+}
+
+fn bar(progress: &MultiProgress, enabled: bool, template: &str) -> ProgressBar {
+    if !enabled {
+        return ProgressBar::hidden();
+    }
+    let bar = progress.add(ProgressBar::new(0));
+    bar.set_style(
+        ProgressStyle::with_template(template)
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+/// Runs the study on `world` (its resolution as given).
+pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, String> {
+    if settings.configurations.is_empty() || settings.seeds == 0 {
+        return Err("a study needs at least one configuration and one seed".into());
+    }
+    if settings.configurations[0].is_oracle() {
+        return Err("the first configuration is the baseline and cannot be the oracle".into());
+    }
+    let multi = MultiProgress::with_draw_target(ProgressDrawTarget::stderr());
+    let reference_bar = bar(
+        &multi,
+        settings.progress,
+        "reference  [{bar:40}] {pos}/{len} spp, {elapsed} elapsed, ETA {eta}",
+    );
+    let base = settings.configurations[0].settings;
+    let reference = match &settings.reference_cache {
+        Some(paths) => {
+            reference::reference(world, &base, settings.reference_spp, paths, &reference_bar)?
+        }
+        None => {
+            let key = format!("ais study {}", std::process::id());
+            let paths = reference::cache_paths(&std::env::temp_dir(), &key);
+            let result =
+                reference::reference(world, &base, settings.reference_spp, &paths, &reference_bar);
+            for path in &paths {
+                let _ = std::fs::remove_file(path);
+            }
+            result?
+        }
+    };
+    reference_bar.finish_and_clear();
+
+    let timed: Vec<&Configuration> = settings
+        .configurations
+        .iter()
+        .filter(|c| !c.is_oracle())
+        .collect();
+    let runs_total = (timed.len() + settings.configurations.len()) as u64 * settings.seeds as u64;
+    let study_bar = bar(
+        &multi,
+        settings.progress,
+        "study      [{bar:40}] {pos}/{len} runs, {elapsed} elapsed, ETA {eta}  {msg}",
+    );
+    study_bar.set_length(runs_total);
+    let seed_of = |s: u32| mix64(0xa15 ^ s as u64);
+    let budget = Budget::Seconds(settings.time_budget.as_secs_f64());
+    let mut results: Vec<ConfigurationResult> = Vec::new();
+    for configuration in &settings.configurations {
+        let mut equal_time = Vec::new();
+        if !configuration.is_oracle() {
+            for s in 0..settings.seeds {
+                study_bar.set_message(format!("{} (equal time, seed {s})", configuration.name));
+                equal_time.push(progressive(
+                    world,
+                    configuration.settings,
+                    &reference,
+                    seed_of(s),
+                    budget,
+                ));
+                study_bar.inc(1);
+            }
+        }
+        results.push(ConfigurationResult {
+            configuration: configuration.clone(),
+            equal_time,
+            equal_rays: Vec::new(),
+        });
+    }
+    let mut baseline_rays: Vec<u64> = results[0]
+        .equal_time
+        .iter()
+        .map(|r| r.rays.total())
+        .collect();
+    baseline_rays.sort_unstable();
+    let ray_budget = baseline_rays[baseline_rays.len() / 2];
+    for result in &mut results {
+        for s in 0..settings.seeds {
+            study_bar.set_message(format!(
+                "{} (equal rays, seed {s})",
+                result.configuration.name
+            ));
+            result.equal_rays.push(progressive(
+                world,
+                result.configuration.settings,
+                &reference,
+                seed_of(s) ^ 0xe0,
+                Budget::Rays(ray_budget),
+            ));
+            study_bar.inc(1);
+        }
+    }
+    study_bar.finish_and_clear();
+    let figure = affinity_figure::snapshots(world, &base, settings.figure_pixel, seed_of(0));
+    Ok(StudyResults {
+        reference,
+        ray_budget,
+        results,
+        figure,
+    })
+}
+
+/// Writes `text` to `path` through a temporary file (an error names the path).
+pub fn write_text(path: &Path, text: &str) -> Result<(), String> {
+    crate::atomic_write::write_atomically(path, |temporary| std::fs::write(temporary, text))
+        .map_err(|e: std::io::Error| format!("{}: cannot write: {e}", path.display()))
+}

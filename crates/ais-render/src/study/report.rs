@@ -1,0 +1,397 @@
+//! The study's report: one self-contained HTML file (images, plots and script inline, no
+//! network), and the same tables as Markdown for BENCHMARKS.md.
+
+use super::affinity_figure::{snapshot_svg, SNAPSHOTS};
+use super::metrics::{relative_error_colours, rgbe};
+use super::plots::{log_log_svg, Series};
+use super::{mean_and_error, ConfigurationResult, Run, StudyResults};
+use crate::image_io::RgbImage;
+use base64::Engine;
+use std::fmt::Write;
+
+/// What the report says about the study besides its results.
+pub struct ReportContext<'a> {
+    /// The scene (a file, or the built-in default scene).
+    pub scene: &'a str,
+    /// Image size.
+    pub resolution: (u32, u32),
+    /// Gather rays per camera sample.
+    pub rays: u32,
+    /// Equal-time budget per run (seconds).
+    pub time_budget: f64,
+    /// Seeds per configuration.
+    pub seeds: u32,
+    /// Reference samples per pixel.
+    pub reference_spp: u32,
+    /// Worker threads.
+    pub threads: usize,
+    /// The affinity-map figure's pixel.
+    pub figure_pixel: (u32, u32),
+}
+
+/// One row of the summary tables.
+struct Row<'a> {
+    result: &'a ConfigurationResult,
+    time_rel_mse: (f64, f64),
+    rays_rel_mse: (f64, f64),
+}
+
+fn rows(results: &StudyResults) -> Vec<Row<'_>> {
+    let summary = |runs: &[Run]| {
+        if runs.is_empty() {
+            (f64::NAN, f64::NAN)
+        } else {
+            mean_and_error(&runs.iter().map(Run::rel_mse).collect::<Vec<_>>())
+        }
+    };
+    results
+        .results
+        .iter()
+        .map(|result| Row {
+            result,
+            time_rel_mse: summary(&result.equal_time),
+            rays_rel_mse: summary(&result.equal_rays),
+        })
+        .collect()
+}
+
+fn average(runs: &[Run], value: impl Fn(&Run) -> f64) -> f64 {
+    runs.iter().map(value).sum::<f64>() / runs.len().max(1) as f64
+}
+
+/// The summary tables as Markdown: equal time, then equal rays with the oracle's share.
+pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> String {
+    let rows = rows(results);
+    let pixels = (context.resolution.0 * context.resolution.1) as f64;
+    let base = &rows[0];
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        "Equal time ({:.1} s per run, {} seeds; ratio = baseline relMSE / relMSE, above 1 is \
+         better; relMSE less the reference's own noise, {:.2e}):\n",
+        context.time_budget,
+        context.seeds,
+        results.reference.noise_floor()
+    );
+    out.push_str("| configuration | spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | relMSE | ratio |\n|---|---|---|---|---|---|---|\n");
+    for row in rows.iter().filter(|r| !r.result.equal_time.is_empty()) {
+        let runs = &row.result.equal_time;
+        let spp = average(runs, |r| r.spp as f64);
+        let _ = writeln!(
+            out,
+            "| {} | {:.1} | {:.0} | {:.1} | {:.1} | {:.3e} ± {:.1e} | {:.2}× |",
+            row.result.configuration.name,
+            spp,
+            spp * context.rays as f64,
+            average(runs, |r| r.rays.occlusion as f64) / pixels,
+            average(runs, |r| r.stats.rejected_roulette as f64) / pixels,
+            row.time_rel_mse.0,
+            row.time_rel_mse.1,
+            base.time_rel_mse.0 / row.time_rel_mse.0
+        );
+    }
+    let oracle = rows.iter().find(|r| r.result.configuration.is_oracle());
+    let _ = writeln!(
+        out,
+        "\nEqual rays ({:.0} rays per run, the baseline's median at equal time; oracle share = \
+         (baseline − relMSE) / (baseline − oracle relMSE)):\n",
+        results.ray_budget as f64
+    );
+    out.push_str(
+        "| configuration | spp | relMSE | ratio | oracle share |\n|---|---|---|---|---|\n",
+    );
+    for row in &rows {
+        let share = oracle.map_or(f64::NAN, |o| {
+            (base.rays_rel_mse.0 - row.rays_rel_mse.0) / (base.rays_rel_mse.0 - o.rays_rel_mse.0)
+        });
+        let _ = writeln!(
+            out,
+            "| {} | {:.1} | {:.3e} ± {:.1e} | {:.2}× | {} |",
+            row.result.configuration.name,
+            average(&row.result.equal_rays, |r| r.spp as f64),
+            row.rays_rel_mse.0,
+            row.rays_rel_mse.1,
+            base.rays_rel_mse.0 / row.rays_rel_mse.0,
+            if share.is_finite() {
+                format!("{:.0}%", 100.0 * share)
+            } else {
+                "–".into()
+            }
+        );
+    }
+    out
+}
+
+fn png_data_url(width: usize, height: usize, rgb: &[[u8; 3]]) -> Result<String, String> {
+    use image::ImageEncoder;
+    let mut bytes = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut bytes)
+        .write_image(
+            rgb.as_flattened(),
+            width as u32,
+            height as u32,
+            image::ExtendedColorType::Rgb8,
+        )
+        .map_err(|e| format!("cannot encode a PNG: {e}"))?;
+    Ok(format!(
+        "data:image/png;base64,{}",
+        base64::engine::general_purpose::STANDARD.encode(bytes)
+    ))
+}
+
+fn escape(text: &str) -> String {
+    text.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
+/// A canvas showing image `name` from the embedded set, with a caption.
+fn figure_canvas(name: &str, caption: &str) -> String {
+    format!(
+        r#"<figure><canvas class="hdr" data-image="{}"></canvas><figcaption>{}</figcaption></figure>"#,
+        escape(name),
+        escape(caption)
+    )
+}
+
+/// The whole report as HTML.
+pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, String> {
+    let (width, height) = (
+        results.reference.image.width,
+        results.reference.image.height,
+    );
+    fn seed0(result: &ConfigurationResult) -> &RgbImage {
+        result
+            .equal_time
+            .first()
+            .or(result.equal_rays.first())
+            .map(|r| &r.image)
+            .expect("every configuration has runs")
+    }
+    // Embedded HDR images: the reference and each configuration's first run.
+    let mut images = String::from("{");
+    let mut embed = |name: &str, image: &RgbImage| {
+        let _ = write!(
+            images,
+            "{:?}:{{w:{},h:{},rgbe:\"{}\"}},",
+            name,
+            image.width,
+            image.height,
+            base64::engine::general_purpose::STANDARD.encode(rgbe(image))
+        );
+    };
+    embed("reference", &results.reference.image);
+    for result in &results.results {
+        embed(&result.configuration.name, seed0(result));
+    }
+    images.push('}');
+
+    let mut options = String::from(r#"<option value="reference">reference</option>"#);
+    for result in &results.results {
+        let _ = write!(
+            options,
+            r#"<option value="{0}">{0}</option>"#,
+            escape(&result.configuration.name)
+        );
+    }
+
+    let mut errors = String::new();
+    for result in &results.results {
+        let url = png_data_url(
+            width,
+            height,
+            &relative_error_colours(seed0(result), &results.reference.image, 0.5),
+        )?;
+        let run = if result.equal_time.is_empty() {
+            "equal rays"
+        } else {
+            "equal time"
+        };
+        let _ = write!(
+            errors,
+            r#"<figure><img class="error-map" src="{url}" width="{width}" height="{height}" alt="relative error of {0}"><figcaption>{0} ({run}, seed 0)</figcaption></figure>"#,
+            escape(&result.configuration.name)
+        );
+    }
+
+    let curves = |pick: &dyn Fn(&ConfigurationResult) -> &[Run],
+                  x: &dyn Fn(&super::CurvePoint) -> f64| {
+        results
+            .results
+            .iter()
+            .filter(|r| !pick(r).is_empty())
+            .map(|r| Series {
+                label: r.configuration.name.clone(),
+                points: pick(r)[0].curve.iter().map(|p| (x(p), p.rel_mse)).collect(),
+            })
+            .collect::<Vec<_>>()
+    };
+    let time_plot = log_log_svg(
+        "relMSE against render time (equal-time runs, seed 0)",
+        "seconds",
+        "relMSE",
+        &curves(&|r| &r.equal_time, &|p| p.seconds),
+        (640, 400),
+    )?;
+    let rays_plot = log_log_svg(
+        "relMSE against rays traced (equal-ray runs, seed 0)",
+        "rays",
+        "relMSE",
+        &curves(&|r| &r.equal_rays, &|p| p.rays as f64),
+        (640, 400),
+    )?;
+
+    let find = |name: &str| {
+        results
+            .results
+            .iter()
+            .find(|r| r.configuration.name == name)
+    };
+    let group = |names: &[&str]| {
+        names
+            .iter()
+            .filter_map(|name| find(name))
+            .map(|r| figure_canvas(&r.configuration.name, &r.configuration.label))
+            .collect::<String>()
+    };
+    let maps = match &results.figure {
+        Some(snapshots) => snapshots
+            .iter()
+            .zip(SNAPSHOTS)
+            .map(|(s, n)| {
+                format!(
+                    "<figure>{}<figcaption>after {n} rays</figcaption></figure>",
+                    snapshot_svg(s, 24)
+                )
+            })
+            .collect::<String>(),
+        None => "<p>The chosen pixel sees no gather point.</p>".into(),
+    };
+
+    let tables = markdown_to_html_tables(&markdown_tables(results, context));
+    let (x, y) = context.figure_pixel;
+    let substitutions: [(&str, String); 20] = [
+        ("SCENE", escape(context.scene)),
+        ("WIDTH", context.resolution.0.to_string()),
+        ("HEIGHT", context.resolution.1.to_string()),
+        ("RAYS", context.rays.to_string()),
+        ("BUDGET", format!("{:.1}", context.time_budget)),
+        ("SEEDS", context.seeds.to_string()),
+        ("REFERENCE_SPP", context.reference_spp.to_string()),
+        (
+            "REFERENCE_CACHED",
+            format!(
+                "{}; its own noise would add {:.2e} to every relMSE, which is subtracted",
+                if results.reference.cached {
+                    " (from the cache)"
+                } else {
+                    ""
+                },
+                results.reference.noise_floor()
+            ),
+        ),
+        ("THREADS", context.threads.to_string()),
+        ("OPTIONS", options),
+        ("ERRORS", errors),
+        ("TIME_PLOT", time_plot),
+        ("RAYS_PLOT", rays_plot),
+        (
+            "FIGURE_UNIFORM",
+            group(&["uniform-off", "mis-off", "mis-aggressive"]),
+        ),
+        (
+            "FIGURE_MODES",
+            group(&["mis-off", "mis-aggressive", "mis-conservative"]),
+        ),
+        (
+            "FIGURE_PLACEMENT",
+            group(&[
+                "mis-off",
+                "mis-off-random",
+                "mis-aggressive",
+                "mis-aggressive-random",
+            ]),
+        ),
+        ("MAPS", maps),
+        ("PIXEL", format!("({x}, {y})")),
+        ("TABLES", tables),
+        ("IMAGES", images),
+    ];
+    // Markers are replaced in this order; none of the inserted texts contains a later marker.
+    let mut html = include_str!("report_template.html").to_string();
+    for (marker, text) in substitutions {
+        html = html.replace(&format!("%%{marker}%%"), &text);
+    }
+    Ok(html)
+}
+
+/// Turns the Markdown tables and their introductory lines into HTML.
+fn markdown_to_html_tables(markdown: &str) -> String {
+    let mut html = String::new();
+    let mut in_table = false;
+    for line in markdown.lines() {
+        if line.starts_with('|') {
+            let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+            if cells.iter().all(|c| c.chars().all(|ch| ch == '-')) {
+                continue;
+            }
+            if !in_table {
+                html.push_str("<table><tr>");
+                for c in &cells {
+                    let _ = write!(html, "<th>{}</th>", escape(c));
+                }
+                html.push_str("</tr>");
+                in_table = true;
+            } else {
+                html.push_str("<tr>");
+                for c in &cells {
+                    let _ = write!(html, "<td>{}</td>", escape(c));
+                }
+                html.push_str("</tr>");
+            }
+        } else {
+            if in_table {
+                html.push_str("</table>");
+                in_table = false;
+            }
+            if !line.trim().is_empty() {
+                let _ = write!(html, "<p>{}</p>", escape(line));
+            }
+        }
+    }
+    if in_table {
+        html.push_str("</table>");
+    }
+    html
+}
+
+/// Writes the report into `folder`: `index.html`, `tables.md`, and the reference and each
+/// configuration's first image as EXR in `images/`. Returns the HTML's path.
+pub fn write(
+    folder: &std::path::Path,
+    results: &StudyResults,
+    context: &ReportContext,
+) -> Result<std::path::PathBuf, String> {
+    let images = folder.join("images");
+    std::fs::create_dir_all(&images)
+        .map_err(|e| format!("{}: cannot create the folder: {e}", images.display()))?;
+    let exr = |name: &str, image: &RgbImage| {
+        crate::image_io::write_exr(&images.join(format!("{name}.exr")), image)
+            .map_err(|e| e.to_string())
+    };
+    exr("reference", &results.reference.image)?;
+    for result in &results.results {
+        let first = result.equal_time.first().or(result.equal_rays.first());
+        if let Some(run) = first {
+            exr(&result.configuration.name, &run.image)?;
+        }
+    }
+    super::write_text(
+        &folder.join("tables.md"),
+        &markdown_tables(results, context),
+    )?;
+    let path = folder.join("index.html");
+    super::write_text(&path, &html(results, context)?)?;
+    Ok(path)
+}
