@@ -1,7 +1,8 @@
 //! `ais compare`: a study of gather configurations on one scene, with an HTML report.
 
 use crate::{
-    gather_settings, load_world, parse_define, parse_resolution, start_threads, GatherFlags,
+    gather_settings, load_world, parse_ais, parse_define, parse_resolution, start_threads,
+    GatherFlags,
 };
 use ais_render::gather::{AisMode, GatherSettings};
 use ais_render::proposal::Strategy;
@@ -28,7 +29,8 @@ pub struct CompareArgs {
     /// of configurations by every strategy × AIS mode (and the oracle).
     #[arg(long, value_delimiter = ',')]
     strategies: Vec<String>,
-    /// AIS modes to compare (off, aggressive, conservative); see --strategies.
+    /// AIS modes to compare (off, aggressive, conservative, shared; +value for value-aware
+    /// acceptance, e.g. shared+value); see --strategies.
     #[arg(long, value_delimiter = ',')]
     ais: Vec<String>,
     /// Rays per gather (n).
@@ -93,11 +95,10 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
             format!("unknown strategy \"{strategy_name}\" (uniform, bsdf, light, mis)")
         })?;
         for mode_name in &modes {
-            let ais = AisMode::parse(mode_name)
-                .filter(|m| *m != AisMode::Oracle)
-                .ok_or_else(|| {
-                    format!("unknown AIS mode \"{mode_name}\" (off, aggressive, conservative)")
-                })?;
+            let (ais, value_aware) = parse_ais(mode_name)?;
+            if ais == AisMode::Oracle {
+                return Err("the oracle is always added; leave it out of --ais".into());
+            }
             let name = format!("{strategy_name}-{mode_name}");
             list.push(Configuration::new(
                 &name,
@@ -105,6 +106,7 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
                 GatherSettings {
                     strategy,
                     ais,
+                    value_aware,
                     ..base
                 },
             ));
@@ -117,6 +119,7 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
         GatherSettings {
             ais: AisMode::Oracle,
             placement: ais::Placement::Random,
+            value_aware: false,
             ..first
         },
     ));

@@ -107,10 +107,16 @@ struct RenderArgs {
     /// Gather proposal: uniform, bsdf, light or mis.
     #[arg(long)]
     strategy: Option<String>,
-    /// AIS mode: off, aggressive, conservative, or oracle (a bound for studies: the proposal
-    /// restricted to directions that bring light, found by free brute-force tests).
+    /// AIS mode: off, aggressive, conservative (the talk's per-batch maps), shared (fixed
+    /// maps blended from neighbouring gather points), or oracle (a bound for studies: the
+    /// proposal restricted to directions that bring light, found by free brute-force tests).
+    /// Append +value for value-aware acceptance (e.g. shared+value).
     #[arg(long)]
     ais: Option<String>,
+    /// Value-aware acceptance: always trace candidates whose unoccluded contribution is
+    /// over twice the batch's mean so far.
+    #[arg(long)]
+    value_aware: bool,
     /// Rays per gather (n).
     #[arg(long)]
     rays: Option<u32>,
@@ -159,6 +165,7 @@ struct GatherFlags {
     rays: Option<u32>,
     tol: Option<f32>,
     map_res: Option<u32>,
+    value_aware: bool,
 }
 
 /// Gather settings: defaults, then the scene's `<integrator type="gather">` properties,
@@ -191,10 +198,11 @@ fn gather_settings(
             .ok_or_else(|| format!("unknown strategy \"{name}\" (uniform, bsdf, light, mis)"))?;
     }
     if let Some(name) = ais {
-        settings.ais = AisMode::parse(&name).ok_or_else(|| {
-            format!("unknown AIS mode \"{name}\" (off, aggressive, conservative, oracle)")
-        })?;
+        let (mode, value_aware) = parse_ais(&name)?;
+        settings.ais = mode;
+        settings.value_aware |= value_aware;
     }
+    settings.value_aware |= args.value_aware;
     if let Some(name) = &args.placement {
         settings.placement = match name.as_str() {
             "halton" => ais::Placement::Halton,
@@ -215,6 +223,21 @@ fn gather_settings(
         return Err("--map-res must be at least 1".into());
     }
     Ok(settings)
+}
+
+/// An AIS mode name, optionally with "+value" for value-aware acceptance.
+fn parse_ais(name: &str) -> Result<(AisMode, bool), String> {
+    let (mode, value_aware) = match name.strip_suffix("+value") {
+        Some(mode) => (mode, true),
+        None => (name, false),
+    };
+    let mode = AisMode::parse(mode).ok_or_else(|| {
+        format!(
+            "unknown AIS mode \"{name}\" (off, aggressive, conservative, shared, oracle; \
+             +value for value-aware acceptance, e.g. shared+value)"
+        )
+    })?;
+    Ok((mode, value_aware))
 }
 
 fn parse_resolution(text: &str) -> Result<(u32, u32), String> {
@@ -329,6 +352,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
                 rays: args.rays,
                 tol: args.tol,
                 map_res: args.map_res,
+                value_aware: args.value_aware,
             };
             Integrator::Gather(gather_settings(&flags, scene_integrator.as_ref())?)
         }

@@ -38,6 +38,11 @@ impl Camera {
         }
     }
 
+    /// The angle one pixel of a `width`-pixel-wide film subtends at the image centre.
+    pub fn pixel_angle(&self, width: u32) -> f32 {
+        2.0 * self.tan_half.0 / width.max(1) as f32
+    }
+
     /// The ray through film position (`u`, `v`) ∈ [0, 1]², `u` to the right and `v` down.
     /// Camera space has +z forward, +y up and +x to the left (Mitsuba's look-at).
     pub fn ray(&self, u: f32, v: f32) -> Ray {

@@ -8,6 +8,7 @@ use crate::geometry::{spawn_ray, Ray};
 use crate::integrator::{RayCounts, SampleContext};
 use crate::lights::luminance;
 use crate::proposal::{GatherPoint, Strategy};
+use crate::shared_maps::RADIUS_PIXELS;
 use crate::world::World;
 use ais::rng::Pcg32;
 use ais::{rating, Batch, BatchConfig, Decision, MapConfig, MapStart, Mode, Stopping};
@@ -22,6 +23,9 @@ pub enum AisMode {
     Aggressive,
     /// The talk's conservative map (shadow-edge resets).
     Conservative,
+    /// Shared maps: each batch starts from a fixed map blended from the batches at
+    /// neighbouring gather points before it (see [`crate::shared_maps`]).
+    Shared,
     /// Not a technique but a bound for studies: the same proposal restricted to the
     /// directions that bring light, found by tracing every candidate for free
     /// (see [`crate::oracle`]).
@@ -36,6 +40,7 @@ impl AisMode {
             "aggressive" => Some(AisMode::Aggressive),
             "conservative" => Some(AisMode::Conservative),
             "oracle" => Some(AisMode::Oracle),
+            "shared" => Some(AisMode::Shared),
             _ => None,
         }
     }
@@ -56,7 +61,14 @@ pub struct GatherSettings {
     pub map_height: u32,
     /// Halton (the talk's) or independent random candidates.
     pub placement: ais::Placement,
+    /// Value-aware acceptance: a candidate whose unoccluded contribution exceeds
+    /// [`VALUE_THRESHOLD`] times the batch's mean so far is always traced.
+    pub value_aware: bool,
 }
+
+/// Value-aware acceptance traces every candidate brighter than this many times the mean
+/// unoccluded contribution of the batch's earlier candidates.
+pub const VALUE_THRESHOLD: f32 = 2.0;
 
 impl Default for GatherSettings {
     fn default() -> Self {
@@ -70,6 +82,7 @@ impl Default for GatherSettings {
             tol: map.tol,
             map_height: map.height,
             placement: ais::Placement::Halton,
+            value_aware: false,
         }
     }
 }
@@ -86,6 +99,16 @@ impl GatherSettings {
         match self.ais {
             AisMode::Off | AisMode::Oracle => BatchConfig {
                 affinity: None,
+                learning: ais::Learning::Off,
+                ..base
+            },
+            AisMode::Shared => BatchConfig {
+                affinity: Some(MapConfig {
+                    height: self.map_height,
+                    tol: self.tol,
+                    ..MapConfig::default()
+                }),
+                // The blended map is held fixed: exactly unbiased.
                 learning: ais::Learning::Off,
                 ..base
             },
@@ -170,55 +193,106 @@ pub fn gather(
         counts,
         batch,
         ais_timer,
+        shared,
     } = context;
+    let sharing = settings.ais == AisMode::Shared;
     let batch = batch.get_or_insert_with(|| {
-        Batch::new(settings.batch_config()).expect("valid gather configuration")
+        let mut batch = Batch::new(settings.batch_config()).expect("valid gather configuration");
+        batch.observe_rays(sharing);
+        batch
     });
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
-    emitted
-        + run_batch(
-            world,
-            settings,
-            &at,
-            batch,
-            seed,
-            counts,
-            ais_timer,
-            &mut |_| {},
-        )
+    let start = if sharing {
+        let radius = RADIUS_PIXELS * hit.t * world.camera.pixel_angle(world.resolution.0);
+        let map = batch.map_mut().expect("shared mode has a map");
+        shared.load_into(map, hit.point, at.frame.normal, radius);
+        MapStart::Current
+    } else {
+        MapStart::Empty
+    };
+    let value = run_batch(
+        world,
+        settings,
+        &at,
+        batch,
+        (seed, start),
+        counts,
+        ais_timer,
+        &mut |_| {},
+    );
+    if sharing {
+        let observations = batch.observations().expect("shared mode observes its rays");
+        shared.remember(hit.point, at.frame.normal, observations);
+    }
+    emitted + value
 }
 
 /// One batch of `settings.rays` rays at `at` through `batch` (configured for `settings`,
-/// or a variant of it); `observe` sees the batch after every traced candidate.
+/// or a variant of it), begun with scrambling seed and map start `(seed, start)`; `observe`
+/// sees the batch after every traced candidate.
 #[allow(clippy::too_many_arguments)]
 pub fn run_batch(
     world: &World,
     settings: &GatherSettings,
     at: &GatherPoint,
     batch: &mut Batch<[f32; 3]>,
-    seed: u64,
+    (seed, start): (u64, MapStart),
     counts: &mut RayCounts,
     timer: &mut AisTimer,
     observe: &mut dyn FnMut(&Batch<[f32; 3]>),
 ) -> Vec3 {
     let (frame, wo, material) = (&at.frame, at.wo, at.material);
     timer.start_gather();
-    batch.begin(settings.rays, seed, MapStart::Empty);
+    batch.begin(settings.rays, seed, start);
+    // Value-aware acceptance: the running mean of earlier candidates' contributions.
+    let (mut value_sum, mut value_count) = (0.0f32, 0u32);
     while let Some(candidate) = batch.next_candidate() {
-        let Some((direction, pdf)) = settings
-            .strategy
-            .sample(at, candidate.u)
-            .filter(|s| s.1 > 0.0)
-        else {
+        let Some(direction) = settings.strategy.sample_direction(at, candidate.u) else {
             timer.decided(frame.normal, false);
             batch.decide(frame.normal, false);
             continue;
         };
         let in_support = material.in_support(frame, wo, direction);
         timer.decided(direction, in_support);
-        if let Decision::Trace { .. } = batch.decide(direction, in_support) {
-            let (actual, unoccluded) = light_along(world, at, direction, counts);
-            let value = material.eval(frame, wo, direction) * actual / pdf as f32;
+        let mut pdf = None;
+        let decision = if settings.value_aware && in_support {
+            // What the candidate would bring if nothing blocked it is known before tracing.
+            let density = settings.strategy.pdf(at, direction);
+            pdf = Some(density);
+            let leaving = spawn_ray(at.point, frame.geometric, direction);
+            let (unoccluded, _) = world.lights.unoccluded(&leaving);
+            let value = if density > 0.0 {
+                luminance(material.eval(frame, wo, direction) * unoccluded) / density as f32
+            } else {
+                0.0
+            };
+            let threshold = VALUE_THRESHOLD * value_sum / value_count.max(1) as f32;
+            value_sum += value;
+            value_count += 1;
+            batch.decide_with(direction, in_support, |affinity| {
+                if value > threshold {
+                    1.0
+                } else {
+                    affinity
+                }
+            })
+        } else {
+            batch.decide(direction, in_support)
+        };
+        if let Decision::Trace { .. } = decision {
+            // The density is needed only now (a zero density, possible only at a light's
+            // rim in f32, brings nothing).
+            let pdf = pdf.unwrap_or_else(|| settings.strategy.pdf(at, direction));
+            let (actual, unoccluded) = if pdf > 0.0 {
+                light_along(world, at, direction, counts)
+            } else {
+                (Vec3::ZERO, Vec3::ZERO)
+            };
+            let value = if pdf > 0.0 {
+                material.eval(frame, wo, direction) * actual / pdf as f32
+            } else {
+                Vec3::ZERO
+            };
             let rating = rating(luminance(actual), luminance(unoccluded));
             timer.recorded(value.to_array(), rating);
             batch.record(value.to_array(), rating);

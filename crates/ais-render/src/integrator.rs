@@ -41,6 +41,8 @@ pub struct SampleContext {
     pub batch: Option<Batch<[f32; 3]>>,
     /// Time spent in AIS calls (sampled).
     pub ais_timer: crate::ais_timer::AisTimer,
+    /// The recent gathers of this tile, for shared maps.
+    pub shared: crate::shared_maps::SharedMaps,
 }
 
 /// What to compute at each camera sample.

@@ -27,6 +27,7 @@ pub mod proposal;
 pub mod render;
 pub mod scene;
 pub mod shapes;
+pub mod shared_maps;
 pub mod study;
 pub mod world;
 

@@ -78,17 +78,34 @@ impl Strategy {
             Strategy::Bsdf => Some(at.material.sample(&at.frame, at.wo, u)),
             Strategy::Light => at.lights.sample(at.point, u),
             Strategy::Mis => {
+                let direction = self.sample_direction(at, u)?;
+                let pdf = self.pdf(at, direction);
+                (pdf > 0.0).then_some((direction, pdf))
+            }
+        }
+    }
+
+    /// The direction of [`Strategy::sample`] without its density, which costs more than the
+    /// direction for light sampling and MIS: a gather that may skip the candidate asks for
+    /// the density only when it traces it.
+    pub fn sample_direction(self, at: &GatherPoint, u: [f32; 2]) -> Option<Vec3> {
+        match self.effective(at) {
+            Strategy::Uniform => Some(uniform_sphere(u)),
+            Strategy::Bsdf => {
+                let (direction, pdf) = at.material.sample(&at.frame, at.wo, u);
+                (pdf > 0.0).then_some(direction)
+            }
+            Strategy::Light => at.lights.sample_direction(at.point, u),
+            Strategy::Mis => {
                 let w = MIS_BSDF_WEIGHT as f32;
-                let direction = if u[0] < w {
-                    at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]).0
+                if u[0] < w {
+                    Some(at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]).0)
                 } else {
                     at.lights.sample_direction(
                         at.point,
                         [((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]],
-                    )?
-                };
-                let pdf = self.pdf(at, direction);
-                (pdf > 0.0).then_some((direction, pdf))
+                    )
+                }
             }
         }
     }

@@ -17,10 +17,11 @@ const STRATEGIES: [Strategy; 4] = [
     Strategy::Light,
     Strategy::Mis,
 ];
-const MODES: [AisMode; 4] = [
+const MODES: [AisMode; 5] = [
     AisMode::Off,
     AisMode::Aggressive,
     AisMode::Conservative,
+    AisMode::Shared,
     AisMode::Oracle,
 ];
 
@@ -186,6 +187,32 @@ fn every_strategy_and_ais_mode_is_unbiased_against_a_reference() {
     }
 }
 
+#[test]
+fn value_aware_acceptance_is_unbiased_against_a_reference() {
+    let world = occluded_scene();
+    let (reference, reference_se, _) =
+        pixel_statistics(&world, settings(Strategy::Mis, AisMode::Off, 32), 64, 8);
+    for mode in [AisMode::Aggressive, AisMode::Conservative, AisMode::Shared] {
+        let gather = GatherSettings {
+            value_aware: true,
+            ..settings(Strategy::Mis, mode, 16)
+        };
+        let (mean, se, _) = pixel_statistics(&world, gather, 8, 12);
+        let z: Vec<f64> = mean
+            .iter()
+            .zip(&se)
+            .zip(reference.iter().zip(&reference_se))
+            .map(|((m, s), (r, rs))| (m - r) / (s * s + rs * rs).sqrt().max(1e-9))
+            .collect();
+        let worst = z.iter().fold(0.0f64, |w, z| w.max(z.abs()));
+        let mean_square = z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64;
+        assert!(
+            worst < 4.5 && mean_square < 2.0,
+            "{mode:?} + value: worst |z| {worst:.2}, mean z² {mean_square:.2}"
+        );
+    }
+}
+
 /// A 4 × 4 room with walls of height 2 under a constant sky: closed by a ceiling with a
 /// window of half-width `half_width` from `bottom` to `top` in the wall at y = 2, or open to
 /// the sky without a ceiling (a courtyard). Everything is two-sided diffuse.
@@ -287,6 +314,37 @@ fn ais_lowers_variance_at_equal_traced_rays_in_an_occluded_interior() {
     let gain = variance_gain(big_window, Strategy::Bsdf, ais::Placement::Random, 256, 400);
     println!("big window, random placement, n = 256: gain {gain:.2}×");
     assert!(gain > 1.2, "gain {gain:.2}");
+}
+
+/// Var · traced of one probe pixel rendered with `spp` gathers per render (so that shared
+/// maps have earlier gathers at the same point to learn from), over `renders` renders.
+fn variance_times_rays(world: &World, gather: GatherSettings, spp: u32, renders: u64) -> f64 {
+    let (_, se, traced) = pixel_statistics(world, gather, spp, renders);
+    se[0] * se[0] * traced
+}
+
+#[test]
+fn shared_maps_beat_per_batch_ais_and_no_ais_at_equal_traced_rays() {
+    // The big-window interior at n = 128, MIS proposal, Halton placement (the defaults),
+    // 8 gathers per pixel: each gather after the first starts from the earlier ones' map.
+    let (mut off, mut per_batch, mut shared) = (0.0, 0.0, 0.0);
+    for target in PROBES {
+        let world = big_window(target);
+        let with = |ais| settings(Strategy::Mis, ais, 128);
+        off += variance_times_rays(&world, with(AisMode::Off), 8, 150);
+        per_batch += variance_times_rays(&world, with(AisMode::Aggressive), 8, 150);
+        shared += variance_times_rays(&world, with(AisMode::Shared), 8, 150);
+    }
+    println!(
+        "Var · traced relative to AIS off: per-batch {:.2}, shared {:.2}",
+        per_batch / off,
+        shared / off
+    );
+    assert!(shared < 0.8 * off, "shared {shared:.3e} vs off {off:.3e}");
+    assert!(
+        shared < 0.8 * per_batch,
+        "shared {shared:.3e} vs per-batch {per_batch:.3e}"
+    );
 }
 
 /// A measurement, not a check: AIS's variance gain in three rooms for both placements.

@@ -50,6 +50,17 @@ fn images_are_bit_identical_at_one_and_two_threads() {
         lit_one.ais_time.as_nanos() > 0,
         "the AIS time estimate is measured"
     );
+    // Shared maps (with value-aware acceptance) learn across gathers in a fixed order.
+    let shared = Integrator::Gather(ais_render::gather::GatherSettings {
+        ais: ais_render::gather::AisMode::Shared,
+        value_aware: true,
+        ..Default::default()
+    });
+    let shared_one = render_with(1, shared);
+    let shared_two = render_with(2, shared);
+    assert_eq!(bits(&shared_one.image), bits(&shared_two.image));
+    assert_eq!(shared_one.ais, shared_two.ais);
+    assert!(shared_one.ais.rejected_roulette > 0, "shared maps reject");
     let one = render_with(1, ao);
     let two = render_with(2, ao);
     assert_eq!(bits(&one.image), bits(&two.image));

@@ -255,6 +255,44 @@ impl AffinityMap {
         self.generation = other.generation;
     }
 
+    /// Sets this map to what `sources` learned, each weighted: every texel becomes
+    /// `[s, ω] = [1, 1] + Σ w · ([s, ω]_source − [1, 1])`, i.e. the fresh prior plus the
+    /// weighted evidence of each source (their recorded rays count `w` times). Used to start
+    /// a batch from maps learned at neighbouring gather points ("shared maps"). Sources must
+    /// have this map's height and levels (their `mode` and `tol` may differ); weights must
+    /// be finite and non-negative. Resets are not carried over.
+    pub fn blend_from(&mut self, sources: &[(&AffinityMap, f32)]) {
+        self.clear();
+        if sources.is_empty() {
+            return;
+        }
+        for (source, weight) in sources {
+            assert!(
+                source.config.height == self.config.height
+                    && source.config.levels == self.config.levels,
+                "blend_from needs sources of the same height and levels"
+            );
+            assert!(
+                weight.is_finite() && *weight >= 0.0,
+                "blend weights must be finite and non-negative, got {weight}"
+            );
+        }
+        let generation = self.generation;
+        for index in 0..self.texels.len() {
+            let mut blended = TexelState {
+                generation,
+                ..TexelState::FRESH
+            };
+            for (source, weight) in sources {
+                let state = source.state(index);
+                blended.sum += weight * (state.sum - 1.0);
+                blended.weight += weight * (state.weight - 1.0);
+                blended.samples += (*weight * state.samples as f32).round() as u32;
+            }
+            self.texels[index] = blended;
+        }
+    }
+
     #[inline]
     fn state(&self, index: usize) -> TexelState {
         let state = self.texels[index];
@@ -391,6 +429,29 @@ mod tests {
             levels,
         })
         .unwrap()
+    }
+
+    #[test]
+    fn blending_adds_weighted_evidence_to_the_prior() {
+        let dir = Vec3::new(0.3, 0.2, 0.9).normalize();
+        let mut a = map(Mode::Aggressive, f32::INFINITY, LevelRule::Single);
+        let mut b = map(Mode::Conservative, 4.0, LevelRule::Single);
+        // a: two rays of rating 0 at weight 1 → [s, ω] = [1, 3].
+        for _ in 0..2 {
+            let lookup = a.lookup(dir);
+            a.record(&lookup, 0.0, 1.0);
+        }
+        // b: one ray of rating 1 at weight 2 → [3, 3].
+        let lookup = b.lookup(dir);
+        b.record(&lookup, 1.0, 0.5);
+        let mut blended = map(Mode::Aggressive, f32::INFINITY, LevelRule::Single);
+        blended.blend_from(&[(&a, 0.5), (&b, 1.0)]);
+        // [1 + 0.5·0 + 1·2, 1 + 0.5·2 + 1·2] = [3, 4] → affinity 0.75.
+        assert!((blended.lookup(dir).affinity - 0.75).abs() < 1e-6);
+        // Other texels stay fresh; no sources gives a fresh map.
+        assert_eq!(blended.lookup(-dir).affinity, 1.0);
+        blended.blend_from(&[]);
+        assert_eq!(blended.lookup(dir).affinity, 1.0);
     }
 
     #[test]

@@ -264,6 +264,9 @@ pub struct Batch<V: Value> {
     done: bool,
     batch_stats: Stats,
     stats: Stats,
+    /// Every traced ray of the current batch, recorded whatever the learning mode (see
+    /// [`Batch::observe_rays`]).
+    observations: Option<AffinityMap>,
 }
 
 impl<V: Value> Batch<V> {
@@ -312,7 +315,30 @@ impl<V: Value> Batch<V> {
             done: true,
             batch_stats: Stats::default(),
             stats: Stats::default(),
+            observations: None,
         })
+    }
+
+    /// Also record every traced ray of each batch in an aggressive map of the same shape,
+    /// whatever the learning mode (off by default). A host that shares maps between gather
+    /// points reads it after [`Batch::finish`] with [`Batch::observations`] and blends such
+    /// maps into the next batch's fixed map ([`AffinityMap::blend_from`]). Needs a map.
+    pub fn observe_rays(&mut self, on: bool) {
+        self.observations = match (on, self.config.affinity) {
+            (true, Some(config)) => Some(
+                AffinityMap::new(MapConfig {
+                    mode: crate::Mode::Aggressive,
+                    ..config
+                })
+                .expect("the map's own configuration is valid"),
+            ),
+            _ => None,
+        };
+    }
+
+    /// What the current (or last) batch traced, when [`Batch::observe_rays`] is on.
+    pub fn observations(&self) -> Option<&AffinityMap> {
+        self.observations.as_ref()
     }
 
     /// The configuration.
@@ -350,6 +376,9 @@ impl<V: Value> Batch<V> {
             if let Some(map) = self.map.as_mut() {
                 map.clear();
             }
+        }
+        if let Some(observations) = self.observations.as_mut() {
+            observations.clear();
         }
         self.plan = match (self.config.learning, self.config.stopping) {
             (Learning::Epochs { epochs }, _) if self.map.is_some() => {
@@ -441,6 +470,21 @@ impl<V: Value> Batch<V> {
     /// Decides whether the current candidate, in `direction` (unit, in the map's frame), is
     /// traced. `in_support` is false for directions outside the BSDF's support.
     pub fn decide(&mut self, direction: Vec3, in_support: bool) -> Decision {
+        self.decide_with(direction, in_support, |affinity| affinity)
+    }
+
+    /// [`Batch::decide`] with the host choosing the acceptance probability from the map's
+    /// affinity: `acceptance(affinity)` must lie in (0, 1] and may depend on the candidate
+    /// itself (its direction, its unoccluded contribution) and on what happened before it,
+    /// but not on its own acceptance. The traced ray's weight is `1 / acceptance`, so the
+    /// estimate stays exactly unbiased (value-aware acceptance: never skip a bright light).
+    /// Values above 1 count as 1; 0 or NaN rejects the candidate.
+    pub fn decide_with(
+        &mut self,
+        direction: Vec3,
+        in_support: bool,
+        acceptance: impl FnOnce(f32) -> f32,
+    ) -> Decision {
         debug_assert!(!self.done, "decide called on a finished batch");
         self.epoch_candidates += 1;
         self.batch_stats.candidates += 1;
@@ -449,7 +493,13 @@ impl<V: Value> Batch<V> {
             return Decision::Reject(RejectReason::OutsideSupport);
         }
         let lookup = self.map.as_ref().map(|map| map.lookup(direction));
-        let affinity = lookup.map_or(1.0, |l| l.affinity);
+        let chosen = acceptance(lookup.map_or(1.0, |l| l.affinity));
+        // An acceptance of 0 (or NaN) always rejects, as an affinity of 0 would.
+        let affinity = if chosen.is_nan() {
+            0.0
+        } else {
+            chosen.clamp(0.0, 1.0)
+        };
         if self.acceptance >= affinity {
             self.batch_stats.rejected_roulette += 1;
             return Decision::Reject(RejectReason::Roulette);
@@ -488,6 +538,9 @@ impl<V: Value> Batch<V> {
         self.epoch_sum = self
             .epoch_sum
             .add(contribution.scale(1.0 / pending.affinity as f64));
+        if let (Some(observations), Some(lookup)) = (self.observations.as_mut(), pending.lookup) {
+            observations.record(&lookup, rating.clamp(0.0, 1.0), pending.affinity);
+        }
         if let (Some(map), Some(lookup)) = (self.map.as_mut(), pending.lookup) {
             let rating = rating.clamp(0.0, 1.0);
             match self.config.learning {

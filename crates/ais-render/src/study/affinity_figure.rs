@@ -81,7 +81,7 @@ pub fn snapshots(
         &settings,
         &at,
         &mut batch,
-        seed,
+        (seed, ais::MapStart::Empty),
         &mut counts,
         &mut timer,
         &mut observe,

@@ -98,7 +98,7 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
         results.ray_budget as f64
     );
     out.push_str(
-        "| configuration | spp | relMSE | ratio | oracle share |\n|---|---|---|---|---|\n",
+        "| configuration | spp | time (s) | relMSE | ratio | oracle share |\n|---|---|---|---|---|---|\n",
     );
     for row in &rows {
         let share = oracle.map_or(f64::NAN, |o| {
@@ -106,9 +106,10 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
         });
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.3e} ± {:.1e} | {:.2}× | {} |",
+            "| {} | {:.1} | {:.2} | {:.3e} ± {:.1e} | {:.2}× | {} |",
             row.result.configuration.name,
             average(&row.result.equal_rays, |r| r.spp as f64),
+            average(&row.result.equal_rays, |r| r.seconds),
             row.rays_rel_mse.0,
             row.rays_rel_mse.1,
             base.rays_rel_mse.0 / row.rays_rel_mse.0,

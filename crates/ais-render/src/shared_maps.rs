@@ -1,0 +1,105 @@
+//! Shared affinity maps: each gather starts from a fixed map blended from what the batches
+//! at neighbouring gather points traced before it.
+//!
+//! Every gather of `--ais shared` records its traced rays in an observation map
+//! ([`ais::Batch::observe_rays`]). A thread remembers the last [`NEIGHBOURS`] gathers of its
+//! current tile (point, normal, observations). The next gather blends them into its own
+//! map, each weighted by `exp(−d²/r²) · max(0, n·n')⁸` (distance `d`, normals `n`, `n'`,
+//! radius `r` = [`RADIUS_PIXELS`] pixel footprints at the hit), and holds that map fixed
+//! while it runs: its acceptance probabilities do not depend on its own rays, so the
+//! estimate is exactly unbiased. Across depth or normal discontinuities the weights vanish
+//! and the map stays fresh (affinity 1, i.e. AIS off). Maps are in world-space directions.
+//!
+//! The memory is per thread, bounded by [`NEIGHBOURS`] maps, and cleared at every tile, so
+//! what a gather sees depends only on the gathers before it in its tile, in the tile's fixed
+//! pixel order: the image is the same for any number of threads.
+
+use ais::AffinityMap;
+use glam::Vec3;
+
+/// How many recent gathers a thread remembers.
+pub const NEIGHBOURS: usize = 16;
+/// The neighbourhood radius, in pixel footprints at the gather point.
+pub const RADIUS_PIXELS: f32 = 3.0;
+/// Neighbours weighing less than this are ignored.
+const LEAST_WEIGHT: f32 = 1e-3;
+
+/// One remembered gather.
+#[derive(Clone, Debug)]
+struct Neighbour {
+    point: Vec3,
+    normal: Vec3,
+    observations: AffinityMap,
+}
+
+/// The recent gathers of one thread's current tile.
+#[derive(Clone, Debug, Default)]
+pub struct SharedMaps {
+    neighbours: Vec<Neighbour>,
+    next: usize,
+}
+
+impl SharedMaps {
+    /// Forgets every gather (at the start of a tile).
+    pub fn clear(&mut self) {
+        self.neighbours.clear();
+        self.next = 0;
+    }
+
+    /// Sets `map` to the blend of the remembered gathers near `point` (with shading normal
+    /// `normal`) within `radius`; returns how many contributed. With none, `map` is fresh.
+    pub fn load_into(
+        &self,
+        map: &mut AffinityMap,
+        point: Vec3,
+        normal: Vec3,
+        radius: f32,
+    ) -> usize {
+        let mut sources: [(&AffinityMap, f32); NEIGHBOURS] = [(map_placeholder(), 0.0); NEIGHBOURS];
+        let mut count = 0;
+        let inverse_r2 = 1.0 / (radius * radius).max(f32::MIN_POSITIVE);
+        for neighbour in &self.neighbours {
+            let facing = neighbour.normal.dot(normal).max(0.0);
+            let weight =
+                (-(neighbour.point - point).length_squared() * inverse_r2).exp() * facing.powi(8);
+            if weight >= LEAST_WEIGHT {
+                sources[count] = (&neighbour.observations, weight);
+                count += 1;
+            }
+        }
+        map.blend_from(&sources[..count]);
+        count
+    }
+
+    /// Remembers a finished gather's observations, replacing the oldest beyond
+    /// [`NEIGHBOURS`].
+    pub fn remember(&mut self, point: Vec3, normal: Vec3, observations: &AffinityMap) {
+        if self.neighbours.len() < NEIGHBOURS {
+            self.neighbours.push(Neighbour {
+                point,
+                normal,
+                observations: observations.clone(),
+            });
+        } else {
+            let slot = &mut self.neighbours[self.next];
+            slot.point = point;
+            slot.normal = normal;
+            slot.observations.copy_from(observations);
+        }
+        self.next = (self.next + 1) % NEIGHBOURS;
+    }
+
+    /// Bytes held (the maps' texels).
+    pub fn memory_bytes(&self) -> usize {
+        self.neighbours
+            .iter()
+            .map(|n| n.observations.memory_bytes() + std::mem::size_of::<Neighbour>())
+            .sum()
+    }
+}
+
+/// A map that fills unused source slots (never read: only `sources[..count]` is passed on).
+fn map_placeholder() -> &'static AffinityMap {
+    static PLACEHOLDER: std::sync::OnceLock<AffinityMap> = std::sync::OnceLock::new();
+    PLACEHOLDER.get_or_init(|| AffinityMap::new(ais::MapConfig::default()).expect("valid"))
+}
