@@ -29,8 +29,8 @@ pub struct CompareArgs {
     /// of configurations by every strategy × AIS mode (and the oracle).
     #[arg(long, value_delimiter = ',')]
     strategies: Vec<String>,
-    /// AIS modes to compare (off, aggressive, conservative, shared; +value for value-aware
-    /// acceptance, e.g. shared+value); see --strategies.
+    /// AIS modes to compare (off, aggressive, conservative, shared; +value or +efficient
+    /// for value-aware acceptance, e.g. shared+efficient); see --strategies.
     #[arg(long, value_delimiter = ',')]
     ais: Vec<String>,
     /// Rays per gather (n).
@@ -95,7 +95,7 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
             format!("unknown strategy \"{strategy_name}\" (uniform, bsdf, light, mis)")
         })?;
         for mode_name in &modes {
-            let (ais, value_aware) = parse_ais(mode_name)?;
+            let (ais, acceptance) = parse_ais(mode_name)?;
             if ais == AisMode::Oracle {
                 return Err("the oracle is always added; leave it out of --ais".into());
             }
@@ -106,7 +106,7 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
                 GatherSettings {
                     strategy,
                     ais,
-                    value_aware,
+                    acceptance,
                     ..base
                 },
             ));
@@ -119,7 +119,7 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
         GatherSettings {
             ais: AisMode::Oracle,
             placement: ais::Placement::Random,
-            value_aware: false,
+            acceptance: ais_render::gather::Acceptance::Affinity,
             ..first
         },
     ));

@@ -1,7 +1,7 @@
 //! The `ais` command.
 
 use ais_render::default_scene::default_world;
-use ais_render::gather::{AisMode, GatherSettings};
+use ais_render::gather::{Acceptance, AisMode, GatherSettings};
 use ais_render::image_io::RgbImage;
 use ais_render::image_io::{write_exr, write_png};
 use ais_render::integrator::Integrator;
@@ -110,13 +110,13 @@ struct RenderArgs {
     /// AIS mode: off, aggressive, conservative (the talk's per-batch maps), shared (fixed
     /// maps blended from neighbouring gather points), or oracle (a bound for studies: the
     /// proposal restricted to directions that bring light, found by free brute-force tests).
-    /// Append +value for value-aware acceptance (e.g. shared+value).
+    /// Append +value or +efficient for value-aware acceptance (e.g. shared+efficient).
     #[arg(long)]
     ais: Option<String>,
-    /// Value-aware acceptance: always trace candidates whose unoccluded contribution is
-    /// over twice the batch's mean so far.
+    /// Acceptance rule: affinity (the talk's), value (always trace candidates worth over
+    /// twice the batch's mean) or efficient (√affinity · value / mean).
     #[arg(long)]
-    value_aware: bool,
+    acceptance: Option<String>,
     /// Rays per gather (n).
     #[arg(long)]
     rays: Option<u32>,
@@ -165,7 +165,7 @@ struct GatherFlags {
     rays: Option<u32>,
     tol: Option<f32>,
     map_res: Option<u32>,
-    value_aware: bool,
+    acceptance: Option<String>,
 }
 
 /// Gather settings: defaults, then the scene's `<integrator type="gather">` properties,
@@ -198,11 +198,14 @@ fn gather_settings(
             .ok_or_else(|| format!("unknown strategy \"{name}\" (uniform, bsdf, light, mis)"))?;
     }
     if let Some(name) = ais {
-        let (mode, value_aware) = parse_ais(&name)?;
+        let (mode, acceptance) = parse_ais(&name)?;
         settings.ais = mode;
-        settings.value_aware |= value_aware;
+        settings.acceptance = acceptance;
     }
-    settings.value_aware |= args.value_aware;
+    if let Some(name) = &args.acceptance {
+        settings.acceptance = Acceptance::parse(name)
+            .ok_or_else(|| format!("unknown acceptance \"{name}\" (affinity, value, efficient)"))?;
+    }
     if let Some(name) = &args.placement {
         settings.placement = match name.as_str() {
             "halton" => ais::Placement::Halton,
@@ -225,19 +228,16 @@ fn gather_settings(
     Ok(settings)
 }
 
-/// An AIS mode name, optionally with "+value" for value-aware acceptance.
-fn parse_ais(name: &str) -> Result<(AisMode, bool), String> {
-    let (mode, value_aware) = match name.strip_suffix("+value") {
-        Some(mode) => (mode, true),
-        None => (name, false),
-    };
-    let mode = AisMode::parse(mode).ok_or_else(|| {
-        format!(
+/// An AIS mode name, optionally with "+value" or "+efficient" for value-aware acceptance.
+fn parse_ais(name: &str) -> Result<(AisMode, Acceptance), String> {
+    let (mode, rule) = name.split_once('+').unwrap_or((name, ""));
+    match (AisMode::parse(mode), Acceptance::parse(rule)) {
+        (Some(mode), Some(acceptance)) => Ok((mode, acceptance)),
+        _ => Err(format!(
             "unknown AIS mode \"{name}\" (off, aggressive, conservative, shared, oracle; \
-             +value for value-aware acceptance, e.g. shared+value)"
-        )
-    })?;
-    Ok((mode, value_aware))
+             +value or +efficient for value-aware acceptance, e.g. shared+efficient)"
+        )),
+    }
 }
 
 fn parse_resolution(text: &str) -> Result<(u32, u32), String> {
@@ -352,7 +352,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
                 rays: args.rays,
                 tol: args.tol,
                 map_res: args.map_res,
-                value_aware: args.value_aware,
+                acceptance: args.acceptance.clone(),
             };
             Integrator::Gather(gather_settings(&flags, scene_integrator.as_ref())?)
         }

@@ -53,7 +53,7 @@ fn images_are_bit_identical_at_one_and_two_threads() {
     // Shared maps (with value-aware acceptance) learn across gathers in a fixed order.
     let shared = Integrator::Gather(ais_render::gather::GatherSettings {
         ais: ais_render::gather::AisMode::Shared,
-        value_aware: true,
+        acceptance: ais_render::gather::Acceptance::ValueEfficient,
         ..Default::default()
     });
     let shared_one = render_with(1, shared);

@@ -36,21 +36,33 @@ struct Row<'a> {
     rays_rel_mse: (f64, f64),
 }
 
-fn rows(results: &StudyResults) -> Vec<Row<'_>> {
-    let summary = |runs: &[Run]| {
-        if runs.is_empty() {
-            (f64::NAN, f64::NAN)
-        } else {
-            mean_and_error(&runs.iter().map(Run::rel_mse).collect::<Vec<_>>())
-        }
-    };
+/// Mean and standard error over runs of relMSE scaled to the budget: relMSE × cost /
+/// budget. A run stops after the pass that crosses its budget, so it overshoots by up to
+/// one pass; relMSE of an unbiased estimator falls as 1 / cost, so scaling removes the
+/// overshoot (it matters when a budget holds only a few passes).
+fn scaled_rel_mse(runs: &[Run], cost: impl Fn(&Run) -> f64, budget: f64) -> (f64, f64) {
+    if runs.is_empty() {
+        return (f64::NAN, f64::NAN);
+    }
+    let scaled: Vec<f64> = runs
+        .iter()
+        .map(|r| r.rel_mse() * cost(r) / budget)
+        .collect();
+    mean_and_error(&scaled)
+}
+
+fn rows<'a>(results: &'a StudyResults, context: &ReportContext) -> Vec<Row<'a>> {
     results
         .results
         .iter()
         .map(|result| Row {
             result,
-            time_rel_mse: summary(&result.equal_time),
-            rays_rel_mse: summary(&result.equal_rays),
+            time_rel_mse: scaled_rel_mse(&result.equal_time, |r| r.seconds, context.time_budget),
+            rays_rel_mse: scaled_rel_mse(
+                &result.equal_rays,
+                |r| r.rays.total() as f64,
+                results.ray_budget as f64,
+            ),
         })
         .collect()
 }
@@ -61,14 +73,15 @@ fn average(runs: &[Run], value: impl Fn(&Run) -> f64) -> f64 {
 
 /// The summary tables as Markdown: equal time, then equal rays with the oracle's share.
 pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> String {
-    let rows = rows(results);
+    let rows = rows(results, context);
     let pixels = (context.resolution.0 * context.resolution.1) as f64;
     let base = &rows[0];
     let mut out = String::new();
     let _ = writeln!(
         out,
         "Equal time ({:.1} s per run, {} seeds; ratio = baseline relMSE / relMSE, above 1 is \
-         better; relMSE less the reference's own noise, {:.2e}):\n",
+         better; relMSE less the reference's own noise, {:.2e}, and scaled to the budget: \
+         relMSE × time / budget):\n",
         context.time_budget,
         context.seeds,
         results.reference.noise_floor()
@@ -93,8 +106,8 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
     let oracle = rows.iter().find(|r| r.result.configuration.is_oracle());
     let _ = writeln!(
         out,
-        "\nEqual rays ({:.0} rays per run, the baseline's median at equal time; oracle share = \
-         (baseline − relMSE) / (baseline − oracle relMSE)):\n",
+        "\nEqual rays ({:.0} rays per run, the baseline's median at equal time; relMSE × rays / \
+         budget; oracle share = (baseline − relMSE) / (baseline − oracle relMSE)):\n",
         results.ray_budget as f64
     );
     out.push_str(
