@@ -163,6 +163,29 @@ fn occluded_scene() -> World {
     world("occluded", &xml, &[])
 }
 
+/// Asserts that `gather` agrees with the converged reference of the occluded scene pixel by
+/// pixel: no |z| above 4.5 and a mean z² below 2.
+fn assert_agrees_with_the_reference(
+    world: &World,
+    (reference, reference_se): (&[f64], &[f64]),
+    gather: GatherSettings,
+    what: &str,
+) {
+    let (mean, se, _) = pixel_statistics(world, gather, 8, 12);
+    let z: Vec<f64> = mean
+        .iter()
+        .zip(&se)
+        .zip(reference.iter().zip(reference_se))
+        .map(|((m, s), (r, rs))| (m - r) / (s * s + rs * rs).sqrt().max(1e-9))
+        .collect();
+    let worst = z.iter().fold(0.0f64, |w, z| w.max(z.abs()));
+    let mean_square = z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64;
+    assert!(
+        worst < 4.5 && mean_square < 2.0,
+        "{what}: worst |z| {worst:.2}, mean z² {mean_square:.2}"
+    );
+}
+
 #[test]
 fn every_strategy_and_ais_mode_is_unbiased_against_a_reference() {
     let world = occluded_scene();
@@ -170,18 +193,11 @@ fn every_strategy_and_ais_mode_is_unbiased_against_a_reference() {
         pixel_statistics(&world, settings(Strategy::Mis, AisMode::Off, 32), 64, 8);
     for strategy in STRATEGIES {
         for mode in MODES {
-            let (mean, se, _) = pixel_statistics(&world, settings(strategy, mode, 16), 8, 12);
-            let z: Vec<f64> = mean
-                .iter()
-                .zip(&se)
-                .zip(reference.iter().zip(&reference_se))
-                .map(|((m, s), (r, rs))| (m - r) / (s * s + rs * rs).sqrt().max(1e-9))
-                .collect();
-            let worst = z.iter().fold(0.0f64, |w, z| w.max(z.abs()));
-            let mean_square = z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64;
-            assert!(
-                worst < 4.5 && mean_square < 2.0,
-                "{strategy:?} {mode:?}: worst |z| {worst:.2}, mean z² {mean_square:.2}"
+            assert_agrees_with_the_reference(
+                &world,
+                (&reference, &reference_se),
+                settings(strategy, mode, 16),
+                &format!("{strategy:?} {mode:?}"),
             );
         }
     }
@@ -201,18 +217,11 @@ fn value_aware_acceptance_is_unbiased_against_a_reference() {
             acceptance,
             ..settings(Strategy::Mis, mode, 16)
         };
-        let (mean, se, _) = pixel_statistics(&world, gather, 8, 12);
-        let z: Vec<f64> = mean
-            .iter()
-            .zip(&se)
-            .zip(reference.iter().zip(&reference_se))
-            .map(|((m, s), (r, rs))| (m - r) / (s * s + rs * rs).sqrt().max(1e-9))
-            .collect();
-        let worst = z.iter().fold(0.0f64, |w, z| w.max(z.abs()));
-        let mean_square = z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64;
-        assert!(
-            worst < 4.5 && mean_square < 2.0,
-            "{mode:?} + {acceptance:?}: worst |z| {worst:.2}, mean z² {mean_square:.2}"
+        assert_agrees_with_the_reference(
+            &world,
+            (&reference, &reference_se),
+            gather,
+            &format!("{mode:?} + {acceptance:?}"),
         );
     }
 }
