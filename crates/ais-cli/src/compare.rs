@@ -2,7 +2,7 @@
 
 use crate::{
     gather_settings, load_world, parse_ais, parse_define, parse_resolution, start_threads,
-    GatherFlags,
+    BatchArgs, GatherFlags,
 };
 use ais_render::gather::{AisMode, GatherSettings};
 use ais_render::proposal::Strategy;
@@ -33,15 +33,8 @@ pub struct CompareArgs {
     /// for value-aware acceptance, e.g. shared+efficient); see --strategies.
     #[arg(long, value_delimiter = ',')]
     ais: Vec<String>,
-    /// Rays per gather (n).
-    #[arg(long)]
-    rays: Option<u32>,
-    /// Affinity-map tol.
-    #[arg(long)]
-    tol: Option<f32>,
-    /// Affinity-map height in texels.
-    #[arg(long)]
-    map_res: Option<u32>,
+    #[command(flatten)]
+    batch: BatchArgs,
     /// Film size (default: the scene's; 320x180 for the default scene).
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,
@@ -141,9 +134,7 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
         (320, 180),
     )?;
     let flags = GatherFlags {
-        rays: args.rays,
-        tol: args.tol,
-        map_res: args.map_res,
+        batch: args.batch,
         ..GatherFlags::default()
     };
     let base = gather_settings(&flags, world.description.integrator.as_ref())?;

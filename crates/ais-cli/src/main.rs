@@ -117,15 +117,8 @@ struct RenderArgs {
     /// twice the batch's mean) or efficient (√affinity · value / mean).
     #[arg(long)]
     acceptance: Option<String>,
-    /// Rays per gather (n).
-    #[arg(long)]
-    rays: Option<u32>,
-    /// Affinity-map tol (a_min = 1/(tol·h²)); "inf" for no floor.
-    #[arg(long)]
-    tol: Option<f32>,
-    /// Affinity-map height in texels (width is twice this).
-    #[arg(long)]
-    map_res: Option<u32>,
+    #[command(flatten)]
+    batch: BatchArgs,
     /// Candidate placement: halton (scrambled per batch) or random.
     #[arg(long)]
     placement: Option<String>,
@@ -156,15 +149,27 @@ struct RenderArgs {
     define: Vec<(String, String)>,
 }
 
+/// The batch and map flags that `render` and `compare` share (None: not given).
+#[derive(clap::Args, Clone, Copy, Default)]
+struct BatchArgs {
+    /// Rays per gather (n).
+    #[arg(long)]
+    rays: Option<u32>,
+    /// Affinity-map tol (a_min = 1/(tol·h²)); "inf" for no floor.
+    #[arg(long)]
+    tol: Option<f32>,
+    /// Affinity-map height in texels (width is twice this).
+    #[arg(long)]
+    map_res: Option<u32>,
+}
+
 /// Gather flags given on the command line (None: not given).
 #[derive(Default)]
 struct GatherFlags {
     strategy: Option<String>,
     ais: Option<String>,
     placement: Option<String>,
-    rays: Option<u32>,
-    tol: Option<f32>,
-    map_res: Option<u32>,
+    batch: BatchArgs,
     acceptance: Option<String>,
 }
 
@@ -213,9 +218,9 @@ fn gather_settings(
             other => return Err(format!("unknown placement \"{other}\" (halton, random)")),
         };
     }
-    settings.rays = args.rays.unwrap_or(settings.rays);
-    settings.tol = args.tol.unwrap_or(settings.tol);
-    settings.map_height = args.map_res.unwrap_or(settings.map_height);
+    settings.rays = args.batch.rays.unwrap_or(settings.rays);
+    settings.tol = args.batch.tol.unwrap_or(settings.tol);
+    settings.map_height = args.batch.map_res.unwrap_or(settings.map_height);
     if settings.rays == 0 {
         return Err("the gather needs at least one ray (--rays)".into());
     }
@@ -349,9 +354,7 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
                 strategy: args.strategy.clone(),
                 ais: args.ais.clone(),
                 placement: args.placement.clone(),
-                rays: args.rays,
-                tol: args.tol,
-                map_res: args.map_res,
+                batch: args.batch,
                 acceptance: args.acceptance.clone(),
             };
             Integrator::Gather(gather_settings(&flags, scene_integrator.as_ref())?)

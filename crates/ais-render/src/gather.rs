@@ -179,28 +179,45 @@ impl GatherSettings {
     }
 }
 
-/// Radiance arriving at the gather point from `direction`: (actual, unoccluded). Only rays
-/// that could bring light are traced (and counted).
+/// The ray leaving the gather point toward `direction`, what it would bring if nothing
+/// blocked it, and how far it must be free (infinite toward the environment).
+fn leaving(world: &World, at: &GatherPoint, direction: Vec3) -> (Ray, Vec3, f32) {
+    let ray = spawn_ray(at.point, at.frame.geometric, direction);
+    let (unoccluded, distance) = world.lights.unoccluded(&ray);
+    (ray, unoccluded, distance)
+}
+
+/// What the `leaving` ray actually brings: its unoccluded radiance, or zero if blocked. Only
+/// rays that could bring light are traced (and counted).
+fn trace_leaving(
+    world: &World,
+    (mut ray, unoccluded, distance): (Ray, Vec3, f32),
+    counts: &mut RayCounts,
+) -> Vec3 {
+    // A ray whose unoccluded radiance is zero brings zero whatever blocks it.
+    if unoccluded == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    // The emitter's own surface is in the BVH: stop just short of it.
+    ray.t_max = distance * (1.0 - 1e-4);
+    counts.occlusion += 1;
+    if world.geometry.occluded(&ray) {
+        Vec3::ZERO
+    } else {
+        unoccluded
+    }
+}
+
+/// Radiance arriving at the gather point from `direction`: (actual, unoccluded).
 pub(crate) fn light_along(
     world: &World,
     at: &GatherPoint,
     direction: Vec3,
     counts: &mut RayCounts,
 ) -> (Vec3, Vec3) {
-    let mut leaving = spawn_ray(at.point, at.frame.geometric, direction);
-    let (unoccluded, distance) = world.lights.unoccluded(&leaving);
-    // The emitter's own surface is in the BVH: stop just short of it. A ray whose
-    // unoccluded radiance is zero brings zero whatever blocks it: no need to trace.
-    if unoccluded == Vec3::ZERO {
-        return (Vec3::ZERO, Vec3::ZERO);
-    }
-    leaving.t_max = distance * (1.0 - 1e-4);
-    counts.occlusion += 1;
-    if world.geometry.occluded(&leaving) {
-        (Vec3::ZERO, unoccluded)
-    } else {
-        (unoccluded, unoccluded)
-    }
+    let ray = leaving(world, at, direction);
+    let unoccluded = ray.1;
+    (trace_leaving(world, ray, counts), unoccluded)
 }
 
 /// The gather point where `hit` is seen from direction `wo` (pointing away from it).
@@ -304,18 +321,19 @@ pub fn run_batch(
         };
         let in_support = material.in_support(frame, wo, direction);
         timer.decided(direction, in_support);
-        let mut pdf = None;
+        // Value-aware rules need the density and the unoccluded radiance before deciding;
+        // the others ask for them only for traced candidates.
+        let mut known = None;
         let decision = if settings.acceptance != Acceptance::Affinity && in_support {
             // What the candidate would bring if nothing blocked it is known before tracing.
             let density = settings.strategy.pdf(at, direction);
-            pdf = Some(density);
-            let leaving = spawn_ray(at.point, frame.geometric, direction);
-            let (unoccluded, _) = world.lights.unoccluded(&leaving);
+            let ray = leaving(world, at, direction);
             let value = if density > 0.0 {
-                luminance(material.eval(frame, wo, direction) * unoccluded) / density as f32
+                luminance(material.eval(frame, wo, direction) * ray.1) / density as f32
             } else {
                 0.0
             };
+            known = Some((density, ray));
             let mean = (value_count > 0).then(|| value_sum / value_count as f32);
             value_sum += value;
             value_count += 1;
@@ -326,20 +344,21 @@ pub fn run_batch(
             batch.decide(direction, in_support)
         };
         if let Decision::Trace { .. } = decision {
-            // The density is needed only now (a zero density, possible only at a light's
-            // rim in f32, brings nothing).
-            let pdf = pdf.unwrap_or_else(|| settings.strategy.pdf(at, direction));
-            let (actual, unoccluded) = if pdf > 0.0 {
-                light_along(world, at, direction, counts)
+            let (pdf, ray) = known.unwrap_or_else(|| {
+                (
+                    settings.strategy.pdf(at, direction),
+                    leaving(world, at, direction),
+                )
+            });
+            let unoccluded = ray.1;
+            // A zero density, possible only at a light's rim in f32, brings nothing.
+            let (value, rating) = if pdf > 0.0 {
+                let actual = trace_leaving(world, ray, counts);
+                let value = material.eval(frame, wo, direction) * actual / pdf as f32;
+                (value, rating(luminance(actual), luminance(unoccluded)))
             } else {
-                (Vec3::ZERO, Vec3::ZERO)
+                (Vec3::ZERO, rating(0.0, 0.0))
             };
-            let value = if pdf > 0.0 {
-                material.eval(frame, wo, direction) * actual / pdf as f32
-            } else {
-                Vec3::ZERO
-            };
-            let rating = rating(luminance(actual), luminance(unoccluded));
             timer.recorded(value.to_array(), rating);
             batch.record(value.to_array(), rating);
             observe(batch);

@@ -55,19 +55,17 @@ impl SharedMaps {
         normal: Vec3,
         radius: f32,
     ) -> usize {
-        let mut sources: [(&AffinityMap, f32); NEIGHBOURS] = [(map_placeholder(), 0.0); NEIGHBOURS];
-        let mut count = 0;
         let inverse_r2 = 1.0 / (radius * radius).max(f32::MIN_POSITIVE);
-        for neighbour in &self.neighbours {
+        let mut count = 0;
+        map.blend_from(self.neighbours.iter().filter_map(|neighbour| {
             let facing = neighbour.normal.dot(normal).max(0.0);
             let weight =
                 (-(neighbour.point - point).length_squared() * inverse_r2).exp() * facing.powi(8);
-            if weight >= LEAST_WEIGHT {
-                sources[count] = (&neighbour.observations, weight);
+            (weight >= LEAST_WEIGHT).then(|| {
                 count += 1;
-            }
-        }
-        map.blend_from(&sources[..count]);
+                (&neighbour.observations, weight)
+            })
+        }));
         count
     }
 
@@ -96,10 +94,4 @@ impl SharedMaps {
             .map(|n| n.observations.memory_bytes() + std::mem::size_of::<Neighbour>())
             .sum()
     }
-}
-
-/// A map that fills unused source slots (never read: only `sources[..count]` is passed on).
-fn map_placeholder() -> &'static AffinityMap {
-    static PLACEHOLDER: std::sync::OnceLock<AffinityMap> = std::sync::OnceLock::new();
-    PLACEHOLDER.get_or_init(|| AffinityMap::new(ais::MapConfig::default()).expect("valid"))
 }

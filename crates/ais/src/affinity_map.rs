@@ -261,11 +261,17 @@ impl AffinityMap {
     /// a batch from maps learned at neighbouring gather points ("shared maps"). Sources must
     /// have this map's height and levels (their `mode` and `tol` may differ); weights must
     /// be finite and non-negative. Resets are not carried over.
-    pub fn blend_from(&mut self, sources: &[(&AffinityMap, f32)]) {
+    pub fn blend_from<'a>(&mut self, sources: impl IntoIterator<Item = (&'a AffinityMap, f32)>) {
         self.clear();
-        if sources.is_empty() {
+        let mut sources = sources.into_iter().peekable();
+        if sources.peek().is_none() {
             return;
         }
+        let fresh = TexelState {
+            generation: self.generation,
+            ..TexelState::FRESH
+        };
+        self.texels.fill(fresh);
         for (source, weight) in sources {
             assert!(
                 source.config.height == self.config.height
@@ -273,23 +279,15 @@ impl AffinityMap {
                 "blend_from needs sources of the same height and levels"
             );
             assert!(
-                weight.is_finite() && *weight >= 0.0,
+                weight.is_finite() && weight >= 0.0,
                 "blend weights must be finite and non-negative, got {weight}"
             );
-        }
-        let generation = self.generation;
-        for index in 0..self.texels.len() {
-            let mut blended = TexelState {
-                generation,
-                ..TexelState::FRESH
-            };
-            for (source, weight) in sources {
+            for (index, blended) in self.texels.iter_mut().enumerate() {
                 let state = source.state(index);
                 blended.sum += weight * (state.sum - 1.0);
                 blended.weight += weight * (state.weight - 1.0);
-                blended.samples += (*weight * state.samples as f32).round() as u32;
+                blended.samples += (weight * state.samples as f32).round() as u32;
             }
-            self.texels[index] = blended;
         }
     }
 
@@ -445,12 +443,12 @@ mod tests {
         let lookup = b.lookup(dir);
         b.record(&lookup, 1.0, 0.5);
         let mut blended = map(Mode::Aggressive, f32::INFINITY, LevelRule::Single);
-        blended.blend_from(&[(&a, 0.5), (&b, 1.0)]);
+        blended.blend_from([(&a, 0.5), (&b, 1.0)]);
         // [1 + 0.5·0 + 1·2, 1 + 0.5·2 + 1·2] = [3, 4] → affinity 0.75.
         assert!((blended.lookup(dir).affinity - 0.75).abs() < 1e-6);
         // Other texels stay fresh; no sources gives a fresh map.
         assert_eq!(blended.lookup(-dir).affinity, 1.0);
-        blended.blend_from(&[]);
+        blended.blend_from([]);
         assert_eq!(blended.lookup(dir).affinity, 1.0);
     }
 
