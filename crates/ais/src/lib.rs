@@ -17,6 +17,8 @@
 //! - [`halton`]: the scrambled 3-D Halton sequence;
 //! - [`epochs`]: frozen-map epochs (the exactly unbiased learning schedule);
 //! - [`batch`]: the driver, the stopping rule and the estimator;
+//! - [`texel_distribution`]: a piecewise-constant density over a map's texels, to fold a
+//!   fixed map into a proposal (guiding) instead of rejecting against it;
 //! - [`chi2`]: the chi-square goodness-of-fit test used to validate samplers;
 //! - [`stats`]: counters; [`value`]: what a batch can average; [`rng`]: a seedable PCG32;
 //! - [`analytic`]: analytic gather scenes with exact integrals, for tests, studies and hosts
@@ -33,6 +35,7 @@ pub mod halton;
 pub mod mapping;
 pub mod rng;
 pub mod stats;
+pub mod texel_distribution;
 pub mod value;
 
 pub use affinity_map::{AffinityMap, LevelRule, MapConfig, MapConfigError, Mode};
@@ -41,4 +44,5 @@ pub use batch::{
     MapStart, Placement, RejectReason, Stopping,
 };
 pub use stats::Stats;
+pub use texel_distribution::TexelDistribution;
 pub use value::Value;

@@ -145,3 +145,67 @@ fn accepted_directions_follow_proposal_times_affinity() {
         assert!(p > SIGNIFICANCE, "{placement:?}: p = {p}");
     }
 }
+
+/// Samples of a texel distribution with uneven weights (some zero), binned on a grid that is
+/// not the texels' (uniform in cos θ, offset in φ), against the integral of its own density.
+#[test]
+fn texel_distribution_fits_its_density() {
+    use ais::TexelDistribution;
+    let mut distribution = TexelDistribution::new(LatLong::new(4));
+    let mut weights = Pcg32::new(9, 9);
+    assert!(distribution.set_weights(|_| {
+        let w = weights.next_f32();
+        if w < 0.3 {
+            0.0
+        } else {
+            w * w
+        }
+    }));
+    let (columns, rows) = (20usize, 10usize);
+    let bin = |direction: glam::Vec3| {
+        let cos_row = (((1.0 - direction.z) / 2.0 * rows as f32) as usize).min(rows - 1);
+        let phi = (direction.y.atan2(direction.x) as f64 + 0.3).rem_euclid(2.0 * PI);
+        let column = ((phi / (2.0 * PI) * columns as f64) as usize).min(columns - 1);
+        cos_row * columns + column
+    };
+    let samples = 300_000u32;
+    let mut observed = vec![0.0; columns * rows];
+    let mut rng = Pcg32::new(4, 2);
+    for _ in 0..samples {
+        let direction = distribution.sample([rng.next_f32(), rng.next_f32()]);
+        assert!((direction.length() - 1.0).abs() < 1e-5);
+        assert!(
+            distribution.pdf(direction) > 0.0,
+            "sampled where the density is 0"
+        );
+        observed[bin(direction)] += 1.0;
+    }
+    // Midpoint rule on 48 × 48 sub-cells per bin (each of equal solid angle).
+    let sub = 48;
+    let mut expected = vec![0.0; columns * rows];
+    for (index, e) in expected.iter_mut().enumerate() {
+        let (cos_row, column) = (index / columns, index % columns);
+        let mut sum = 0.0f64;
+        for i in 0..sub {
+            for j in 0..sub {
+                let z = 1.0 - 2.0 * (cos_row as f64 + (i as f64 + 0.5) / sub as f64) / rows as f64;
+                let phi = 2.0 * PI * (column as f64 + (j as f64 + 0.5) / sub as f64)
+                    / columns as f64
+                    - 0.3;
+                let s = (1.0 - z * z).max(0.0).sqrt();
+                let d = glam::Vec3::new((s * phi.cos()) as f32, (s * phi.sin()) as f32, z as f32);
+                sum += distribution.pdf(d) as f64;
+            }
+        }
+        let bin_solid_angle = 4.0 * PI / (columns * rows) as f64;
+        *e = samples as f64 * sum / (sub * sub) as f64 * bin_solid_angle;
+    }
+    let total: f64 = expected.iter().sum();
+    assert!(
+        (total / samples as f64 - 1.0).abs() < 2e-3,
+        "density integrates to {}",
+        total / samples as f64
+    );
+    let p = chi_square_p_value(&observed, &expected);
+    assert!(p > SIGNIFICANCE, "p = {p}");
+}
