@@ -29,10 +29,13 @@ pub struct CompareArgs {
     /// of configurations by every strategy × AIS mode (and the oracle).
     #[arg(long, value_delimiter = ',')]
     strategies: Vec<String>,
-    /// AIS modes to compare (off, aggressive, conservative, shared; +value or +efficient
+    /// AIS modes to compare (off, aggressive, conservative, shared, guided; +value or +efficient
     /// for value-aware acceptance, e.g. shared+efficient); see --strategies.
     #[arg(long, value_delimiter = ',')]
     ais: Vec<String>,
+    /// Leave out the oracle (with --ais; it traces every candidate, so it is slow).
+    #[arg(long)]
+    no_oracle: bool,
     #[command(flatten)]
     batch: BatchArgs,
     /// Film size (default: the scene's; 320x180 for the default scene).
@@ -104,6 +107,9 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
                 },
             ));
         }
+    }
+    if args.no_oracle {
+        return Ok(list);
     }
     let first = list[0].settings;
     list.push(Configuration::new(

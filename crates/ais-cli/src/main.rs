@@ -108,7 +108,8 @@ struct RenderArgs {
     #[arg(long)]
     strategy: Option<String>,
     /// AIS mode: off, aggressive, conservative (the talk's per-batch maps), shared (fixed
-    /// maps blended from neighbouring gather points), or oracle (a bound for studies: the
+    /// maps blended from neighbouring gather points), guided (the shared map folded into the
+    /// proposal: nothing rejected), or oracle (a bound for studies: the
     /// proposal restricted to directions that bring light, found by free brute-force tests).
     /// Append +value or +efficient for value-aware acceptance (e.g. shared+efficient).
     #[arg(long)]
@@ -161,6 +162,9 @@ struct BatchArgs {
     /// Affinity-map height in texels (width is twice this).
     #[arg(long)]
     map_res: Option<u32>,
+    /// Guided gathers: the guide's share of the proposal mixture, in [0, 0.99].
+    #[arg(long)]
+    guide_fraction: Option<f32>,
 }
 
 /// Gather flags given on the command line (None: not given).
@@ -211,6 +215,9 @@ fn gather_settings(
         settings.acceptance = Acceptance::parse(name)
             .ok_or_else(|| format!("unknown acceptance \"{name}\" (affinity, value, efficient)"))?;
     }
+    if settings.ais == AisMode::Guided && settings.acceptance != Acceptance::Affinity {
+        return Err("guided gathers reject no candidate, so they take no acceptance rule".into());
+    }
     if let Some(name) = &args.placement {
         settings.placement = match name.as_str() {
             "halton" => ais::Placement::Halton,
@@ -221,6 +228,10 @@ fn gather_settings(
     settings.rays = args.batch.rays.unwrap_or(settings.rays);
     settings.tol = args.batch.tol.unwrap_or(settings.tol);
     settings.map_height = args.batch.map_res.unwrap_or(settings.map_height);
+    settings.guide_fraction = args.batch.guide_fraction.unwrap_or(settings.guide_fraction);
+    if !(0.0..=0.99).contains(&settings.guide_fraction) {
+        return Err("--guide-fraction must lie in [0, 0.99]".into());
+    }
     if settings.rays == 0 {
         return Err("the gather needs at least one ray (--rays)".into());
     }
@@ -239,7 +250,7 @@ fn parse_ais(name: &str) -> Result<(AisMode, Acceptance), String> {
     match (AisMode::parse(mode), Acceptance::parse(rule)) {
         (Some(mode), Some(acceptance)) => Ok((mode, acceptance)),
         _ => Err(format!(
-            "unknown AIS mode \"{name}\" (off, aggressive, conservative, shared, oracle; \
+            "unknown AIS mode \"{name}\" (off, aggressive, conservative, shared, guided, oracle; \
              +value or +efficient for value-aware acceptance, e.g. shared+efficient)"
         )),
     }

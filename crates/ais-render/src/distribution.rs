@@ -135,6 +135,11 @@ impl Distribution2D {
         ([x, y], pdf_x * pdf_y)
     }
 
+    /// Probability of the cell in `column` of `row`.
+    pub fn cell_probability(&self, column: usize, row: usize) -> f64 {
+        self.marginal.bin_probability(row) * self.conditionals[row].bin_probability(column)
+    }
+
     /// Density at (x, y).
     pub fn pdf(&self, p: [f64; 2]) -> f64 {
         let rows = self.conditionals.len();

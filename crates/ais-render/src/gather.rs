@@ -5,6 +5,7 @@ use crate::ais_timer::AisTimer;
 use crate::bsdf::ShadingFrame;
 use crate::geometry::Hit;
 use crate::geometry::{spawn_ray, Ray};
+use crate::guiding::{Guidance, Guide, Proposal};
 use crate::integrator::{RayCounts, SampleContext};
 use crate::lights::luminance;
 use crate::proposal::{GatherPoint, Strategy};
@@ -26,6 +27,10 @@ pub enum AisMode {
     /// Shared maps: each batch starts from a fixed map blended from the batches at
     /// neighbouring gather points before it (see [`crate::shared_maps`]).
     Shared,
+    /// Guided gathers: the shared mode's fixed map folded into the proposal (a mixture with
+    /// a piecewise-constant density over its texels) rather than used for roulette: nothing
+    /// is rejected (see [`crate::guiding`]).
+    Guided,
     /// Not a technique but a bound for studies: the same proposal restricted to the
     /// directions that bring light, found by tracing every candidate for free
     /// (see [`crate::oracle`]).
@@ -41,6 +46,7 @@ impl AisMode {
             "conservative" => Some(AisMode::Conservative),
             "oracle" => Some(AisMode::Oracle),
             "shared" => Some(AisMode::Shared),
+            "guided" => Some(AisMode::Guided),
             _ => None,
         }
     }
@@ -63,6 +69,8 @@ pub struct GatherSettings {
     pub placement: ais::Placement,
     /// How a candidate's acceptance probability follows from the map.
     pub acceptance: Acceptance,
+    /// Guided gathers: the guide's share α of the proposal mixture `(1 − α) p + α g`.
+    pub guide_fraction: f32,
 }
 
 /// How a candidate's acceptance probability follows from the map's affinity `q` and, for
@@ -133,6 +141,7 @@ impl Default for GatherSettings {
             map_height: map.height,
             placement: ais::Placement::Halton,
             acceptance: Acceptance::Affinity,
+            guide_fraction: crate::guiding::GUIDE_FRACTION,
         }
     }
 }
@@ -152,7 +161,7 @@ impl GatherSettings {
                 learning: ais::Learning::Off,
                 ..base
             },
-            AisMode::Shared => BatchConfig {
+            AisMode::Shared | AisMode::Guided => BatchConfig {
                 affinity: Some(MapConfig {
                     height: self.map_height,
                     tol: self.tol,
@@ -229,6 +238,7 @@ pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a
         wo,
         material,
         lights: &world.lights,
+        environment_guide: None,
     }
 }
 
@@ -251,7 +261,7 @@ pub fn gather(
     if world.lights.is_empty() {
         return emitted;
     }
-    let at = gather_point(world, &hit, -ray.direction);
+    let mut at = gather_point(world, &hit, -ray.direction);
     if settings.ais == AisMode::Oracle {
         return emitted
             + crate::oracle::gather_with_oracle(world, settings, &at, rng, &mut context.counts);
@@ -261,18 +271,31 @@ pub fn gather(
         batch,
         ais_timer,
         shared,
+        guide,
     } = context;
-    let sharing = settings.ais == AisMode::Shared;
+    let sharing = matches!(settings.ais, AisMode::Shared | AisMode::Guided);
     let batch = batch.get_or_insert_with(|| {
         let mut batch = Batch::new(settings.batch_config()).expect("valid gather configuration");
         batch.observe_rays(sharing);
         batch
     });
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+    let mut proposal = Proposal::plain(settings.strategy);
     let start = if sharing {
         let radius = RADIUS_PIXELS * hit.t * world.camera.pixel_angle(world.resolution.0);
         let map = batch.map_mut().expect("shared mode has a map");
-        shared.load_into(map, hit.point, at.frame.normal, radius);
+        let neighbours = shared.load_into(map, hit.point, at.frame.normal, radius);
+        if settings.ais == AisMode::Guided && neighbours > 0 {
+            let guide = guide.get_or_insert_with(|| Guide::new(settings.map_height));
+            match guide.prepare(map, settings.strategy, &at, settings.guide_fraction) {
+                Guidance::Unguided => {}
+                Guidance::Environment(environment) => at.environment_guide = Some(environment),
+                Guidance::Mixture(distribution) => {
+                    proposal =
+                        Proposal::guided(settings.strategy, distribution, settings.guide_fraction)
+                }
+            }
+        }
         MapStart::Current
     } else {
         MapStart::Empty
@@ -281,7 +304,7 @@ pub fn gather(
         world,
         settings,
         &at,
-        batch,
+        (batch, &proposal),
         (seed, start),
         counts,
         ais_timer,
@@ -295,14 +318,14 @@ pub fn gather(
 }
 
 /// One batch of `settings.rays` rays at `at` through `batch` (configured for `settings`,
-/// or a variant of it), begun with scrambling seed and map start `(seed, start)`; `observe`
+/// or a variant of it) with candidates from `proposal`, begun with scrambling seed and map start `(seed, start)`; `observe`
 /// sees the batch after every traced candidate.
 #[allow(clippy::too_many_arguments)]
 pub fn run_batch(
     world: &World,
     settings: &GatherSettings,
     at: &GatherPoint,
-    batch: &mut Batch<[f32; 3]>,
+    (batch, proposal): (&mut Batch<[f32; 3]>, &Proposal),
     (seed, start): (u64, MapStart),
     counts: &mut RayCounts,
     timer: &mut AisTimer,
@@ -314,7 +337,7 @@ pub fn run_batch(
     // Value-aware acceptance: the running mean of earlier candidates' contributions.
     let (mut value_sum, mut value_count) = (0.0f32, 0u32);
     while let Some(candidate) = batch.next_candidate() {
-        let Some(direction) = settings.strategy.sample_direction(at, candidate.u) else {
+        let Some(direction) = proposal.sample_direction(at, candidate.u) else {
             timer.decided(frame.normal, false);
             batch.decide(frame.normal, false);
             continue;
@@ -326,7 +349,7 @@ pub fn run_batch(
         let mut known = None;
         let decision = if settings.acceptance != Acceptance::Affinity && in_support {
             // What the candidate would bring if nothing blocked it is known before tracing.
-            let density = settings.strategy.pdf(at, direction);
+            let density = proposal.pdf(at, direction);
             let ray = leaving(world, at, direction);
             let value = if density > 0.0 {
                 luminance(material.eval(frame, wo, direction) * ray.1) / density as f32
@@ -340,16 +363,15 @@ pub fn run_batch(
             batch.decide_with(direction, in_support, |affinity| {
                 settings.acceptance.probability(affinity, value, mean)
             })
+        } else if settings.ais == AisMode::Guided {
+            // The map is already in the proposal: trace every candidate.
+            batch.decide_with(direction, in_support, |_| 1.0)
         } else {
             batch.decide(direction, in_support)
         };
         if let Decision::Trace { .. } = decision {
-            let (pdf, ray) = known.unwrap_or_else(|| {
-                (
-                    settings.strategy.pdf(at, direction),
-                    leaving(world, at, direction),
-                )
-            });
+            let (pdf, ray) = known
+                .unwrap_or_else(|| (proposal.pdf(at, direction), leaving(world, at, direction)));
             let unoccluded = ray.1;
             // A zero density, possible only at a light's rim in f32, brings nothing.
             let (value, rating) = if pdf > 0.0 {

@@ -43,6 +43,8 @@ pub struct SampleContext {
     pub ais_timer: crate::ais_timer::AisTimer,
     /// The recent gathers of this tile, for shared maps.
     pub shared: crate::shared_maps::SharedMaps,
+    /// The guide distribution of guided gathers (allocated on first use).
+    pub guide: Option<crate::guiding::Guide>,
 }
 
 /// What to compute at each camera sample.

@@ -18,6 +18,7 @@ pub mod error;
 pub mod film;
 pub mod gather;
 pub mod geometry;
+pub mod guiding;
 pub mod image_io;
 pub mod integrator;
 pub mod lights;

@@ -3,7 +3,7 @@
 
 use crate::bsdf::{Material, ShadingFrame};
 use crate::geometry::uniform_sphere;
-use crate::lights::Lights;
+use crate::lights::{EnvironmentGuide, Lights};
 use glam::Vec3;
 use std::f64::consts::PI;
 
@@ -59,6 +59,9 @@ pub struct GatherPoint<'a> {
     pub material: &'a Material,
     /// The scene's emitters.
     pub lights: &'a Lights,
+    /// Light sampling draws the environment from its product with this batch's fixed
+    /// affinity map (guided gathers), or from the environment alone (`None`).
+    pub environment_guide: Option<&'a EnvironmentGuide>,
 }
 
 impl Strategy {
@@ -76,7 +79,11 @@ impl Strategy {
         match self.effective(at) {
             Strategy::Uniform => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
             Strategy::Bsdf => Some(at.material.sample(&at.frame, at.wo, u)),
-            Strategy::Light => at.lights.sample(at.point, u),
+            Strategy::Light => {
+                let direction = self.sample_direction(at, u)?;
+                let pdf = self.pdf(at, direction);
+                (pdf > 0.0).then_some((direction, pdf))
+            }
             Strategy::Mis => {
                 let direction = self.sample_direction(at, u)?;
                 let pdf = self.pdf(at, direction);
@@ -95,15 +102,18 @@ impl Strategy {
                 let (direction, pdf) = at.material.sample(&at.frame, at.wo, u);
                 (pdf > 0.0).then_some(direction)
             }
-            Strategy::Light => at.lights.sample_direction(at.point, u),
+            Strategy::Light => at
+                .lights
+                .sample_direction_guided(at.point, u, at.environment_guide),
             Strategy::Mis => {
                 let w = MIS_BSDF_WEIGHT as f32;
                 if u[0] < w {
                     Some(at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]).0)
                 } else {
-                    at.lights.sample_direction(
+                    at.lights.sample_direction_guided(
                         at.point,
                         [((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]],
+                        at.environment_guide,
                     )
                 }
             }
@@ -115,10 +125,14 @@ impl Strategy {
         match self.effective(at) {
             Strategy::Uniform => 1.0 / (4.0 * PI),
             Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, direction),
-            Strategy::Light => at.lights.pdf(at.point, direction),
+            Strategy::Light => at
+                .lights
+                .pdf_guided(at.point, direction, at.environment_guide),
             Strategy::Mis => {
                 MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, direction)
-                    + (1.0 - MIS_BSDF_WEIGHT) * at.lights.pdf(at.point, direction)
+                    + (1.0 - MIS_BSDF_WEIGHT)
+                        * at.lights
+                            .pdf_guided(at.point, direction, at.environment_guide)
             }
         }
     }

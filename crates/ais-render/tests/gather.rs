@@ -17,11 +17,12 @@ const STRATEGIES: [Strategy; 4] = [
     Strategy::Light,
     Strategy::Mis,
 ];
-const MODES: [AisMode; 5] = [
+const MODES: [AisMode; 6] = [
     AisMode::Off,
     AisMode::Aggressive,
     AisMode::Conservative,
     AisMode::Shared,
+    AisMode::Guided,
     AisMode::Oracle,
 ];
 

@@ -10,7 +10,9 @@ use ais::rng::Pcg32;
 use ais_render::bsdf::{Material, Microfacet, RoughPlastic, Scattering, ShadingFrame};
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
-use ais_render::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights, Rectangle};
+use ais_render::lights::{
+    AreaLight, AreaShape, Environment, EnvironmentGuide, EnvironmentMap, Lights, Rectangle,
+};
 use ais_render::proposal::{GatherPoint, Strategy};
 use base64::Engine;
 use glam::{DMat3, Vec3};
@@ -177,6 +179,59 @@ fn synthetic_envmap_with_a_tiny_sun_fits() {
     }
 }
 
+/// The environment drawn from its product with a fixed affinity map (guided gathers): alone
+/// and as a defensive mixture, directly and through MIS light sampling at a gather point.
+#[test]
+fn environment_guided_by_an_affinity_map_fits() {
+    let rotation = DMat3::from_rotation_x(0.5) * DMat3::from_rotation_z(0.3);
+    let map = EnvironmentMap::new(gradient_with_sun(64, 32), rotation);
+    let layout = LatLong::new(4);
+    let mut guide = EnvironmentGuide::new(&map, layout);
+    // Uneven affinities, the sun's texel among the smallest.
+    let sun_texel = layout.texel(map.brightest_direction());
+    guide.set_affinities(|t| {
+        if t == sun_texel {
+            1e-3
+        } else {
+            0.05 + ((t.row * 7 + t.column * 3) % 5) as f32 * 0.2
+        }
+    });
+    for (seed, fraction) in [(20, 1.0), (21, 0.5)] {
+        guide.set_fraction(fraction);
+        let p = fit(
+            200_000,
+            seed,
+            |u| {
+                let d = guide.sample(&map, u);
+                Some((d, guide.pdf(&map, d)))
+            },
+            |d| guide.pdf(&map, d),
+        );
+        assert!(p > SIGNIFICANCE, "fraction {fraction}: p = {p}");
+    }
+    let lights = Lights::new(Some(Environment::Map(Box::new(map))), Vec::new(), 0, 10.0);
+    let material = Material::default();
+    let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
+    let wo = Vec3::new(-0.3, 0.2, 1.0).normalize();
+    let at = GatherPoint {
+        point: Vec3::ZERO,
+        frame: ShadingFrame::new(&material, normal, normal, wo),
+        wo,
+        material: &material,
+        lights: &lights,
+        environment_guide: Some(&guide),
+    };
+    for (seed, strategy) in [(22, Strategy::Light), (23, Strategy::Mis)] {
+        let p = fit(
+            200_000,
+            seed,
+            |u| strategy.sample(&at, u),
+            |d| strategy.pdf(&at, d),
+        );
+        assert!(p > SIGNIFICANCE, "guided {strategy:?}: p = {p}");
+    }
+}
+
 #[test]
 fn real_hdri_from_npm_fits() {
     let Some(package) = common::npm_package("the npm HDRI chi2 test", "@pmndrs/assets@1.7.0")
@@ -337,6 +392,7 @@ fn every_gather_proposal_fits() {
         wo,
         material: &material,
         lights: &lights,
+        environment_guide: None,
     };
     for (seed, strategy) in [
         Strategy::Uniform,

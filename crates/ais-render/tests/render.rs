@@ -61,6 +61,20 @@ fn images_are_bit_identical_at_one_and_two_threads() {
     assert_eq!(bits(&shared_one.image), bits(&shared_two.image));
     assert_eq!(shared_one.ais, shared_two.ais);
     assert!(shared_one.ais.rejected_roulette > 0, "shared maps reject");
+    // Guided gathers build their proposal from the same neighbourhood maps.
+    let guided = Integrator::Gather(ais_render::gather::GatherSettings {
+        ais: ais_render::gather::AisMode::Guided,
+        ..Default::default()
+    });
+    let guided_one = render_with(1, guided);
+    let guided_two = render_with(2, guided);
+    assert_eq!(bits(&guided_one.image), bits(&guided_two.image));
+    assert_eq!(guided_one.ais, guided_two.ais);
+    assert_ne!(
+        bits(&guided_one.image),
+        bits(&lit_one.image),
+        "the guide changes the proposal"
+    );
     let one = render_with(1, ao);
     let two = render_with(2, ao);
     assert_eq!(bits(&one.image), bits(&two.image));

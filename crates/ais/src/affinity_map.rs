@@ -392,6 +392,11 @@ impl AffinityMap {
         self.texels[index].resets += 1;
     }
 
+    /// The affinity floor `a_min` of one level (its affinity with every ray blocked).
+    pub fn min_affinity(&self, level: usize) -> f32 {
+        self.levels[..self.level_count][level].min_affinity
+    }
+
     /// Affinity of one texel of one level, as that level alone would give it.
     pub fn texel_affinity(&self, level: usize, texel: crate::mapping::Texel) -> f32 {
         let level = self.levels[..self.level_count][level];

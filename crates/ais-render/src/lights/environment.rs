@@ -126,8 +126,17 @@ impl EnvironmentMap {
     }
 
     /// A direction drawn from `u` and its density in solid angle.
-    fn sample(&self, u: [f64; 2]) -> (Vec3, f64) {
+    pub(crate) fn sample(&self, u: [f64; 2]) -> (Vec3, f64) {
         let ([x, y], pdf_cells) = self.distribution.sample(u);
+        let (direction, span) = self.direction_at([x, y]);
+        // Cells are uniform in φ and cos θ, so the density is constant within each.
+        let rows = self.row_cosines.len() - 1;
+        (direction, pdf_cells / (rows as f64 * 2.0 * PI * span))
+    }
+
+    /// The world direction at the distribution's cell coordinates (x, y) ∈ [0, 1)², and the
+    /// cos θ span of its cell row.
+    fn direction_at(&self, [x, y]: [f64; 2]) -> (Vec3, f64) {
         let rows = self.row_cosines.len() - 1;
         let row = ((y * rows as f64) as usize).min(rows - 1);
         let t = y * rows as f64 - row as f64;
@@ -136,16 +145,62 @@ impl EnvironmentMap {
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
         let (sin_phi, cos_phi) = (2.0 * PI * (x + 0.5 / self.image.width as f64)).sin_cos();
         let local = DVec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
-        let direction = (self.to_world * local).normalize().as_vec3();
-        // Cells are uniform in φ and cos θ, so the density is constant within each.
-        let pdf = pdf_cells / (rows as f64 * 2.0 * PI * (top - bottom));
-        (direction, pdf)
+        ((self.to_world * local).normalize().as_vec3(), top - bottom)
     }
 
     fn pdf(&self, direction: Vec3) -> f64 {
-        let (cell, span) = self.cell_coordinates(self.uv(direction));
-        let rows = (self.row_cosines.len() - 1) as f64;
-        self.distribution.pdf(cell) / (rows * 2.0 * PI * span)
+        self.pdf_and_cell(direction).0
+    }
+
+    /// The centre of the cell that sampling picks most often (the sun, in a sky).
+    pub fn brightest_direction(&self) -> Vec3 {
+        let brightest = (0..self.cell_count())
+            .max_by(|&a, &b| {
+                self.cell_probability(a)
+                    .total_cmp(&self.cell_probability(b))
+            })
+            .unwrap_or(0);
+        self.cell_centre(brightest)
+    }
+
+    /// Number of sampling cells (`width × (height − 1)`, row-major).
+    pub(crate) fn cell_count(&self) -> usize {
+        self.image.width * (self.row_cosines.len() - 1)
+    }
+
+    /// Probability that sampling picks `cell`.
+    pub(crate) fn cell_probability(&self, cell: usize) -> f64 {
+        let width = self.image.width;
+        self.distribution
+            .cell_probability(cell % width, cell / width)
+    }
+
+    /// The world direction through the centre of `cell`.
+    pub(crate) fn cell_centre(&self, cell: usize) -> Vec3 {
+        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
+        let x = ((cell % width) as f64 + 0.5) / width as f64;
+        let y = ((cell / width) as f64 + 0.5) / rows as f64;
+        self.direction_at([x, y]).0
+    }
+
+    /// The direction at fractions (`fx`, `fy`) ∈ [0, 1)² of `cell`'s azimuth and cos θ range:
+    /// with uniform fractions, uniform in solid angle over the cell, as sampling draws.
+    pub(crate) fn direction_in_cell(&self, cell: usize, [fx, fy]: [f64; 2]) -> Vec3 {
+        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
+        let x = ((cell % width) as f64 + fx) / width as f64;
+        let y = ((cell / width) as f64 + fy) / rows as f64;
+        self.direction_at([x.min(1.0 - f64::EPSILON), y.min(1.0 - f64::EPSILON)])
+            .0
+    }
+
+    /// The sampling density at `direction` (solid angle) and the cell it falls in.
+    pub(crate) fn pdf_and_cell(&self, direction: Vec3) -> (f64, usize) {
+        let ([x, y], span) = self.cell_coordinates(self.uv(direction));
+        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
+        let column = ((x * width as f64) as usize).min(width - 1);
+        let row = ((y * rows as f64) as usize).min(rows - 1);
+        let density = self.distribution.pdf([x, y]) / (rows as f64 * 2.0 * PI * span);
+        (density, row * width + column)
     }
 }
 

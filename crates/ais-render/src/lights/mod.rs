@@ -3,10 +3,12 @@
 
 mod area;
 mod environment;
+mod environment_guide;
 mod spherical_rectangle;
 
 pub use area::{AreaLight, AreaSample, AreaShape};
 pub use environment::{luminance, Environment, EnvironmentMap};
+pub use environment_guide::EnvironmentGuide;
 pub use spherical_rectangle::Rectangle;
 
 use crate::distribution::Distribution1D;
@@ -69,13 +71,26 @@ impl Lights {
     /// power, then a direction toward it. Its density is [`Lights::pdf`] (all lights that
     /// could have produced it), which callers evaluate once.
     pub fn sample_direction(&self, point: Vec3, u: [f32; 2]) -> Option<Vec3> {
+        self.sample_direction_guided(point, u, None)
+    }
+
+    /// [`Lights::sample_direction`] with the environment map sampled by `guide` (its product
+    /// with an affinity map) when given; the density is then [`Lights::pdf_guided`].
+    pub fn sample_direction_guided(
+        &self,
+        point: Vec3,
+        u: [f32; 2],
+        guide: Option<&EnvironmentGuide>,
+    ) -> Option<Vec3> {
         let choice = self.choice.as_ref()?;
         let (x, _, index) = choice.sample(u[0] as f64);
         let u0 = ((x * choice.len() as f64 - index as f64).clamp(0.0, 1.0 - 1e-7)) as f32;
         if index < self.area.len() {
-            Some(self.area[index].sample(point, [u0, u[1]])?.direction)
-        } else {
-            Some(self.environment.as_ref()?.sample([u0, u[1]]).0)
+            return Some(self.area[index].sample(point, [u0, u[1]])?.direction);
+        }
+        match (self.environment.as_ref()?, guide) {
+            (Environment::Map(map), Some(guide)) => Some(guide.sample(map, [u0, u[1]])),
+            (environment, _) => Some(environment.sample([u0, u[1]]).0),
         }
     }
 
@@ -88,6 +103,16 @@ impl Lights {
 
     /// Density of light sampling at `direction` from `point`, in solid angle.
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
+        self.pdf_guided(point, direction, None)
+    }
+
+    /// Density of [`Lights::sample_direction_guided`] with the same `guide`.
+    pub fn pdf_guided(
+        &self,
+        point: Vec3,
+        direction: Vec3,
+        guide: Option<&EnvironmentGuide>,
+    ) -> f64 {
         let mut pdf = 0.0;
         for (index, light) in self.area.iter().enumerate() {
             let p = self.choice_probability(index);
@@ -96,7 +121,11 @@ impl Lights {
             }
         }
         if let Some(environment) = &self.environment {
-            pdf += self.choice_probability(self.area.len()) * environment.pdf(direction);
+            let density = match (environment, guide) {
+                (Environment::Map(map), Some(guide)) => guide.pdf(map, direction),
+                (environment, _) => environment.pdf(direction),
+            };
+            pdf += self.choice_probability(self.area.len()) * density;
         }
         pdf
     }

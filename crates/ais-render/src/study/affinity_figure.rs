@@ -80,7 +80,10 @@ pub fn snapshots(
         world,
         &settings,
         &at,
-        &mut batch,
+        (
+            &mut batch,
+            &crate::guiding::Proposal::plain(settings.strategy),
+        ),
         (seed, ais::MapStart::Empty),
         &mut counts,
         &mut timer,

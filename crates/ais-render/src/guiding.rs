@@ -1,0 +1,162 @@
+//! Guided gathers: the fixed map of a shared-map gather folded into the proposal instead of
+//! used for Russian roulette.
+//!
+//! `--ais guided` blends the same neighbourhood map as `--ais shared`
+//! ([`crate::shared_maps`]), but rather than drawing candidates from the strategy's density
+//! `p` and skipping those the map thinks blocked, it draws them from the mixture
+//! `q = (1 − α) p + α g`, where `g` is piecewise constant over the map's texels with texel
+//! probabilities ∝ affinity × `p` at the texel's centre × solid angle (an approximation of
+//! the product `p · affinity`). Every in-support candidate is traced and weighs `f / q`, so
+//! nothing is paid for rejected candidates and stratified placement stays stratified. Since
+//! `(1 − α) p` is always in the mixture, the estimate is exactly unbiased whatever the map
+//! says; a bad map costs at most a factor `1 / (1 − α)` in variance.
+
+use crate::lights::{Environment, EnvironmentGuide};
+use crate::proposal::{GatherPoint, Strategy};
+use ais::mapping::LatLong;
+use ais::{AffinityMap, TexelDistribution};
+use glam::Vec3;
+
+/// The default share α of the guide in the mixture `q = (1 − α) p + α g`.
+pub const GUIDE_FRACTION: f32 = 0.5;
+
+/// The least affinity a guide gives any texel, so that no direction loses all density.
+pub const GUIDE_FLOOR: f32 = 1e-3;
+
+/// The proposal a gather draws candidates from: the strategy alone, or mixed with a guide.
+#[derive(Clone, Copy)]
+pub struct Proposal<'a> {
+    strategy: Strategy,
+    guide: Option<&'a TexelDistribution>,
+    /// The guide's share α.
+    fraction: f32,
+}
+
+impl<'a> Proposal<'a> {
+    /// The strategy alone.
+    pub fn plain(strategy: Strategy) -> Self {
+        Proposal {
+            strategy,
+            guide: None,
+            fraction: 0.0,
+        }
+    }
+
+    /// The mixture of `strategy` (share 1 − `fraction`) and `guide` (share `fraction`, in
+    /// [0, 1); clamped so that the strategy always keeps a share and the estimate stays
+    /// unbiased).
+    pub fn guided(strategy: Strategy, guide: &'a TexelDistribution, fraction: f32) -> Self {
+        Proposal {
+            strategy,
+            guide: Some(guide),
+            fraction: fraction.clamp(0.0, 0.99),
+        }
+    }
+
+    /// A candidate direction from `u` ∈ [0, 1)² (`None`: the strategy gave none).
+    pub fn sample_direction(&self, at: &GatherPoint, u: [f32; 2]) -> Option<Vec3> {
+        let Some(guide) = self.guide else {
+            return self.strategy.sample_direction(at, u);
+        };
+        let alpha = self.fraction;
+        if u[0] < alpha {
+            Some(guide.sample([u[0] / alpha, u[1]]))
+        } else {
+            let rescaled = ((u[0] - alpha) / (1.0 - alpha)).min(1.0 - 1e-7);
+            self.strategy.sample_direction(at, [rescaled, u[1]])
+        }
+    }
+
+    /// The proposal's density at `direction`, in solid angle.
+    pub fn pdf(&self, at: &GatherPoint, direction: Vec3) -> f64 {
+        let p = self.strategy.pdf(at, direction);
+        match self.guide {
+            None => p,
+            Some(guide) => {
+                let alpha = self.fraction as f64;
+                (1.0 - alpha) * p + alpha * guide.pdf(direction) as f64
+            }
+        }
+    }
+}
+
+/// How a guided batch draws its candidates.
+pub enum Guidance<'g> {
+    /// From the strategy alone (no neighbour, or no texel with weight).
+    Unguided,
+    /// Light sampling draws the environment map from its product with the map.
+    Environment(&'g EnvironmentGuide),
+    /// From the mixture of the strategy and this texel distribution.
+    Mixture(&'g TexelDistribution),
+}
+
+/// A thread's reusable guides.
+#[derive(Clone, Debug)]
+pub struct Guide {
+    distribution: TexelDistribution,
+    environment: Option<EnvironmentGuide>,
+}
+
+impl Guide {
+    /// Guides on a map layout of `height` rows.
+    pub fn new(height: u32) -> Self {
+        Guide {
+            distribution: TexelDistribution::new(LatLong::new(height)),
+            environment: None,
+        }
+    }
+
+    /// How the batch at `at` follows `map` (level 0): strategies that sample lights in a
+    /// scene with an environment map draw it from its exact product with the map
+    /// ([`EnvironmentGuide`]); the others mix in a texel distribution whose weights are
+    /// affinity × the strategy's density at the texel's centre × solid angle (zero where the
+    /// centre is outside the BSDF's support).
+    pub fn prepare(
+        &mut self,
+        map: &AffinityMap,
+        strategy: Strategy,
+        at: &GatherPoint,
+        fraction: f32,
+    ) -> Guidance<'_> {
+        let layout = map.level_layout(0);
+        let samples_lights = matches!(strategy, Strategy::Light | Strategy::Mis);
+        if let (true, Some(Environment::Map(environment))) =
+            (samples_lights, &at.lights.environment)
+        {
+            if self.environment.as_ref().map(EnvironmentGuide::layout) != Some(layout) {
+                self.environment = Some(EnvironmentGuide::new(environment, layout));
+            }
+            let guide = self.environment.as_mut().expect("just built");
+            guide.set_fraction(fraction as f64);
+            // No ray of the neighbours went where the BSDF has no support, so the map knows
+            // nothing there: give such texels the floor. Never 0, so the product keeps
+            // density wherever light sampling alone had it (exactly unbiased).
+            let floor = map.min_affinity(0).max(GUIDE_FLOOR);
+            guide.set_affinities(|texel| {
+                let centre = layout.center_direction(texel);
+                if at.material.in_support(&at.frame, at.wo, centre) {
+                    map.texel_affinity(0, texel).max(floor)
+                } else {
+                    floor
+                }
+            });
+            return Guidance::Environment(guide);
+        }
+        if self.distribution.layout() != layout {
+            self.distribution = TexelDistribution::new(layout);
+        }
+        let built = self.distribution.set_weights(|texel| {
+            let centre = layout.center_direction(texel);
+            if !at.material.in_support(&at.frame, at.wo, centre) {
+                return 0.0;
+            }
+            let density = strategy.pdf(at, centre) as f32;
+            map.texel_affinity(0, texel) * density * layout.texel_solid_angle(texel.row)
+        });
+        if built {
+            Guidance::Mixture(&self.distribution)
+        } else {
+            Guidance::Unguided
+        }
+    }
+}
