@@ -2,14 +2,19 @@
 //! used for Russian roulette.
 //!
 //! `--ais guided` blends the same neighbourhood map as `--ais shared`
-//! ([`crate::shared_maps`]), but rather than drawing candidates from the strategy's density
-//! `p` and skipping those the map thinks blocked, it draws them from the mixture
-//! `q = (1 − α) p + α g`, where `g` is piecewise constant over the map's texels with texel
-//! probabilities ∝ affinity × `p` at the texel's centre × solid angle (an approximation of
-//! the product `p · affinity`). Every in-support candidate is traced and weighs `f / q`, so
-//! nothing is paid for rejected candidates and stratified placement stays stratified. Since
-//! `(1 − α) p` is always in the mixture, the estimate is exactly unbiased whatever the map
-//! says; a bad map costs at most a factor `1 / (1 − α)` in variance.
+//! ([`crate::shared_maps`]) and holds it fixed, but rather than drawing candidates from the
+//! strategy's density `p` and skipping those the map thinks blocked, it changes what is drawn,
+//! so every in-support candidate is traced and weighs `f / q`: nothing is paid for rejected
+//! candidates and stratified placement stays stratified.
+//! - Strategies that sample lights, in a scene with an environment map, draw the environment
+//!   from a defensive mixture with its exact product with the map
+//!   ([`crate::lights::EnvironmentGuide`]); the BSDF half of MIS is unchanged.
+//! - Other strategies draw from `q = (1 − α) p + α g`, where `g` is piecewise constant over
+//!   the map's texels with probabilities ∝ affinity × `p` at the texel's centre × solid
+//!   angle (an approximation of the product `p · affinity`).
+//!
+//! Both keep a share of the unguided density everywhere, so the estimate is exactly
+//! unbiased whatever the map says, and a wrong map costs at most `1 / (1 − α)` in variance.
 
 use crate::lights::{Environment, EnvironmentGuide};
 use crate::proposal::{GatherPoint, Strategy};
