@@ -29,7 +29,7 @@ pub struct CompareArgs {
     /// of configurations by every strategy × AIS mode (and the oracle).
     #[arg(long, value_delimiter = ',')]
     strategies: Vec<String>,
-    /// AIS modes to compare (off, aggressive, conservative, shared, guided; +value or +efficient
+    /// AIS modes to compare (off, aggressive, conservative, shared, warm, guided; +sqrt, +value or +efficient
     /// for value-aware acceptance, e.g. shared+efficient); see --strategies.
     #[arg(long, value_delimiter = ',')]
     ais: Vec<String>,
@@ -140,7 +140,7 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
         (320, 180),
     )?;
     let flags = GatherFlags {
-        batch: args.batch,
+        batch: args.batch.clone(),
         ..GatherFlags::default()
     };
     let base = gather_settings(&flags, world.description.integrator.as_ref())?;

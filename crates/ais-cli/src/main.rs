@@ -1,7 +1,7 @@
 //! The `ais` command.
 
 use ais_render::default_scene::default_world;
-use ais_render::gather::{Acceptance, AisMode, GatherSettings};
+use ais_render::gather::{Acceptance, AisMode, GatherSettings, RayBudget};
 use ais_render::image_io::RgbImage;
 use ais_render::image_io::{write_exr, write_png};
 use ais_render::integrator::Integrator;
@@ -108,14 +108,16 @@ struct RenderArgs {
     #[arg(long)]
     strategy: Option<String>,
     /// AIS mode: off, aggressive, conservative (the talk's per-batch maps), shared (fixed
-    /// maps blended from neighbouring gather points), guided (the shared map folded into the
+    /// maps blended from neighbouring gather points), warm (that map as a warm start, then
+    /// per-batch learning), guided (the shared map folded into the
     /// proposal: nothing rejected), or oracle (a bound for studies: the
     /// proposal restricted to directions that bring light, found by free brute-force tests).
-    /// Append +value or +efficient for value-aware acceptance (e.g. shared+efficient).
+    /// Append +sqrt (accept with √affinity), or +value or +efficient for value-aware
+    /// acceptance (e.g. shared+efficient).
     #[arg(long)]
     ais: Option<String>,
-    /// Acceptance rule: affinity (the talk's), value (always trace candidates worth over
-    /// twice the batch's mean) or efficient (√affinity · value / mean).
+    /// Acceptance rule: affinity (the talk's), sqrt (√affinity), value (always trace
+    /// candidates worth over twice the batch's mean) or efficient (√affinity · value / mean).
     #[arg(long)]
     acceptance: Option<String>,
     #[command(flatten)]
@@ -151,7 +153,7 @@ struct RenderArgs {
 }
 
 /// The batch and map flags that `render` and `compare` share (None: not given).
-#[derive(clap::Args, Clone, Copy, Default)]
+#[derive(clap::Args, Clone, Default)]
 struct BatchArgs {
     /// Rays per gather (n).
     #[arg(long)]
@@ -165,6 +167,10 @@ struct BatchArgs {
     /// Guided gathers: the guide's share of the proposal mixture, in [0, 0.99].
     #[arg(long)]
     guide_fraction: Option<f32>,
+    /// What --rays counts: traced (AIS draws extra candidates to trace about that many) or
+    /// candidates (AIS traces only the accepted ones: cheaper gathers).
+    #[arg(long)]
+    budget: Option<String>,
 }
 
 /// Gather flags given on the command line (None: not given).
@@ -212,8 +218,9 @@ fn gather_settings(
         settings.acceptance = acceptance;
     }
     if let Some(name) = &args.acceptance {
-        settings.acceptance = Acceptance::parse(name)
-            .ok_or_else(|| format!("unknown acceptance \"{name}\" (affinity, value, efficient)"))?;
+        settings.acceptance = Acceptance::parse(name).ok_or_else(|| {
+            format!("unknown acceptance \"{name}\" (affinity, sqrt, value, efficient)")
+        })?;
     }
     if settings.ais == AisMode::Guided && settings.acceptance != Acceptance::Affinity {
         return Err("guided gathers reject no candidate, so they take no acceptance rule".into());
@@ -229,6 +236,10 @@ fn gather_settings(
     settings.tol = args.batch.tol.unwrap_or(settings.tol);
     settings.map_height = args.batch.map_res.unwrap_or(settings.map_height);
     settings.guide_fraction = args.batch.guide_fraction.unwrap_or(settings.guide_fraction);
+    if let Some(name) = &args.batch.budget {
+        settings.budget = RayBudget::parse(name)
+            .ok_or_else(|| format!("unknown budget \"{name}\" (traced, candidates)"))?;
+    }
     if !(0.0..=0.99).contains(&settings.guide_fraction) {
         return Err("--guide-fraction must lie in [0, 0.99]".into());
     }
@@ -244,14 +255,15 @@ fn gather_settings(
     Ok(settings)
 }
 
-/// An AIS mode name, optionally with "+value" or "+efficient" for value-aware acceptance.
+/// An AIS mode name, optionally with "+sqrt", "+value" or "+efficient" for another
+/// acceptance rule.
 fn parse_ais(name: &str) -> Result<(AisMode, Acceptance), String> {
     let (mode, rule) = name.split_once('+').unwrap_or((name, ""));
     match (AisMode::parse(mode), Acceptance::parse(rule)) {
         (Some(mode), Some(acceptance)) => Ok((mode, acceptance)),
         _ => Err(format!(
-            "unknown AIS mode \"{name}\" (off, aggressive, conservative, shared, guided, oracle; \
-             +value or +efficient for value-aware acceptance, e.g. shared+efficient)"
+            "unknown AIS mode \"{name}\" (off, aggressive, conservative, shared, warm, guided, oracle; \
+             +sqrt, +value or +efficient for another acceptance rule, e.g. shared+sqrt)"
         )),
     }
 }

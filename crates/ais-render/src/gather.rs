@@ -27,6 +27,10 @@ pub enum AisMode {
     /// Shared maps: each batch starts from a fixed map blended from the batches at
     /// neighbouring gather points before it (see [`crate::shared_maps`]).
     Shared,
+    /// Shared maps as a warm start: each batch starts from the blended map of
+    /// [`AisMode::Shared`], then keeps learning from its own rays in frozen-map epochs
+    /// (exactly unbiased: the map changes only between epochs).
+    Warm,
     /// Guided gathers: the shared mode's fixed map folded into the proposal (a mixture with
     /// a piecewise-constant density over its texels) rather than used for roulette: nothing
     /// is rejected (see [`crate::guiding`]).
@@ -47,6 +51,7 @@ impl AisMode {
             "oracle" => Some(AisMode::Oracle),
             "shared" => Some(AisMode::Shared),
             "guided" => Some(AisMode::Guided),
+            "warm" => Some(AisMode::Warm),
             _ => None,
         }
     }
@@ -71,6 +76,32 @@ pub struct GatherSettings {
     pub acceptance: Acceptance,
     /// Guided gathers: the guide's share α of the proposal mixture `(1 − α) p + α g`.
     pub guide_fraction: f32,
+    /// What `rays` counts: traced rays (AIS draws extra candidates to trace about `rays`)
+    /// or candidates (AIS traces fewer and the gather gets cheaper).
+    pub budget: RayBudget,
+}
+
+/// What a gather's `rays` counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayBudget {
+    /// About `rays` traced rays per gather: every epoch draws ⌈n_e / acceptance rate⌉
+    /// candidates ([`ais::Stopping::CandidateBudget`]). The talk's reading: AIS buys more
+    /// candidates with the same rays.
+    Traced,
+    /// Exactly `rays` candidates per gather, of which AIS traces only the accepted
+    /// ([`ais::Stopping::FixedCandidates`]): AIS makes each gather cheaper.
+    Candidates,
+}
+
+impl RayBudget {
+    /// Parses "traced" or "candidates".
+    pub fn parse(name: &str) -> Option<RayBudget> {
+        match name {
+            "traced" => Some(RayBudget::Traced),
+            "candidates" => Some(RayBudget::Candidates),
+            _ => None,
+        }
+    }
 }
 
 /// How a candidate's acceptance probability follows from the map's affinity `q` and, for
@@ -81,6 +112,10 @@ pub struct GatherSettings {
 pub enum Acceptance {
     /// The talk's: `q`.
     Affinity,
+    /// `√q`: efficiency-optimised roulette when the candidate's value is not known (and so
+    /// costs nothing to decide). A rejected candidate still costs a proposal sample, so
+    /// rejecting in proportion to `q` draws too many of them; `√q` balances the two costs.
+    SqrtAffinity,
     /// `1` when `v > 2 v̄` (never skip a bright candidate), else `q`.
     ValueThreshold,
     /// Efficiency-optimised Russian roulette: `clamp(√q · v / v̄, 10⁻³, 1)`, the
@@ -94,20 +129,31 @@ pub const VALUE_THRESHOLD: f32 = 2.0;
 
 impl Acceptance {
     /// Parses a rule's name: "affinity" (or "", as after a mode name without a suffix),
-    /// "value" or "efficient".
+    /// "sqrt", "value" or "efficient".
     pub fn parse(name: &str) -> Option<Acceptance> {
         match name {
             "" | "affinity" => Some(Acceptance::Affinity),
             "value" => Some(Acceptance::ValueThreshold),
             "efficient" => Some(Acceptance::ValueEfficient),
+            "sqrt" => Some(Acceptance::SqrtAffinity),
             _ => None,
         }
+    }
+
+    /// Whether the rule needs the candidate's unoccluded value (and so its density, the
+    /// BSDF and the lights) before deciding.
+    pub fn needs_value(self) -> bool {
+        matches!(
+            self,
+            Acceptance::ValueThreshold | Acceptance::ValueEfficient
+        )
     }
 
     /// The acceptance probability for affinity `q`, value `v` and earlier mean `mean`.
     fn probability(self, q: f32, v: f32, mean: Option<f32>) -> f32 {
         match (self, mean) {
             (Acceptance::Affinity, _) => q,
+            (Acceptance::SqrtAffinity, _) => q.sqrt(),
             // The first candidate has no mean to compare with: trace it.
             (_, None) => 1.0,
             (Acceptance::ValueThreshold, Some(mean)) => {
@@ -142,6 +188,7 @@ impl Default for GatherSettings {
             placement: ais::Placement::Halton,
             acceptance: Acceptance::Affinity,
             guide_fraction: crate::guiding::GUIDE_FRACTION,
+            budget: RayBudget::Traced,
         }
     }
 }
@@ -151,7 +198,10 @@ impl GatherSettings {
     /// exactly unbiased with Halton placement even when candidates fall outside the support.
     pub fn batch_config(&self) -> BatchConfig {
         let base = BatchConfig {
-            stopping: Stopping::CandidateBudget,
+            stopping: match self.budget {
+                RayBudget::Traced => Stopping::CandidateBudget,
+                RayBudget::Candidates => Stopping::FixedCandidates,
+            },
             placement: self.placement,
             ..BatchConfig::default()
         };
@@ -169,6 +219,15 @@ impl GatherSettings {
                 }),
                 // The blended map is held fixed: exactly unbiased.
                 learning: ais::Learning::Off,
+                ..base
+            },
+            AisMode::Warm => BatchConfig {
+                affinity: Some(MapConfig {
+                    height: self.map_height,
+                    tol: self.tol,
+                    ..MapConfig::default()
+                }),
+                learning: ais::Learning::Epochs { epochs: 4 },
                 ..base
             },
             AisMode::Aggressive | AisMode::Conservative => BatchConfig {
@@ -273,7 +332,10 @@ pub fn gather(
         shared,
         guide,
     } = context;
-    let sharing = matches!(settings.ais, AisMode::Shared | AisMode::Guided);
+    let sharing = matches!(
+        settings.ais,
+        AisMode::Shared | AisMode::Warm | AisMode::Guided
+    );
     let batch = batch.get_or_insert_with(|| {
         let mut batch = Batch::new(settings.batch_config()).expect("valid gather configuration");
         batch.observe_rays(sharing);
@@ -347,7 +409,7 @@ pub fn run_batch(
         // Value-aware rules need the density and the unoccluded radiance before deciding;
         // the others ask for them only for traced candidates.
         let mut known = None;
-        let decision = if settings.acceptance != Acceptance::Affinity && in_support {
+        let decision = if settings.acceptance.needs_value() && in_support {
             // What the candidate would bring if nothing blocked it is known before tracing.
             let density = proposal.pdf(at, direction);
             let ray = leaving(world, at, direction);
@@ -366,6 +428,8 @@ pub fn run_batch(
         } else if settings.ais == AisMode::Guided {
             // The map is already in the proposal: trace every candidate.
             batch.decide_with(direction, in_support, |_| 1.0)
+        } else if settings.acceptance == Acceptance::SqrtAffinity {
+            batch.decide_with(direction, in_support, f32::sqrt)
         } else {
             batch.decide(direction, in_support)
         };

@@ -61,6 +61,16 @@ fn images_are_bit_identical_at_one_and_two_threads() {
     assert_eq!(bits(&shared_one.image), bits(&shared_two.image));
     assert_eq!(shared_one.ais, shared_two.ais);
     assert!(shared_one.ais.rejected_roulette > 0, "shared maps reject");
+    // Warm starts from the same maps, then per-batch learning, with √affinity acceptance.
+    let warm = Integrator::Gather(ais_render::gather::GatherSettings {
+        ais: ais_render::gather::AisMode::Warm,
+        acceptance: ais_render::gather::Acceptance::SqrtAffinity,
+        ..Default::default()
+    });
+    let warm_one = render_with(1, warm);
+    let warm_two = render_with(2, warm);
+    assert_eq!(bits(&warm_one.image), bits(&warm_two.image));
+    assert_eq!(warm_one.ais, warm_two.ais);
     // Guided gathers build their proposal from the same neighbourhood maps.
     let guided = Integrator::Gather(ais_render::gather::GatherSettings {
         ais: ais_render::gather::AisMode::Guided,

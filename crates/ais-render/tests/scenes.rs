@@ -7,31 +7,13 @@ use ais_render::integrator::Integrator;
 use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
-use std::path::PathBuf;
-use std::process::Command;
-
-fn scenes_folder() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes")
-}
 
 #[test]
 fn shipped_scenes_load_and_render() {
-    let folder = scenes_folder();
-    if !folder.join("assets/sky.hdr").exists() {
-        let made = Command::new("python3")
-            .arg(folder.join("make_assets.py"))
-            .status();
-        match made {
-            Ok(status) if status.success() => {}
-            Ok(status) => panic!("scenes/make_assets.py failed: {status}"),
-            Err(e) => {
-                return common::skip(
-                    "the shipped-scenes test",
-                    &format!("python3 could not be run ({e})"),
-                )
-            }
-        }
-    }
+    let folder = match common::shipped_scenes() {
+        Ok(folder) => folder,
+        Err(why) => return common::skip("the shipped-scenes test", &why),
+    };
     for name in ["open", "occluded", "interior"] {
         let path = folder.join(format!("{name}.xml"));
         let overrides = [

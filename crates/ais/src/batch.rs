@@ -78,6 +78,12 @@ pub enum Stopping {
     /// epoch ([`Learning::Epochs`] or [`Learning::Off`]); without a map or with
     /// [`Learning::Off`] the batch is split into 4 doubling epochs just to adapt `M_e`.
     CandidateBudget,
+    /// Every epoch draws exactly `n_e` candidates and traces only the accepted ones, each
+    /// weighted by 1 / acceptance: AIS then saves rays (and time) per batch instead of
+    /// spending more candidates to trace `n`. Exactly unbiased with any placement (the
+    /// candidate count is fixed); needs frozen maps within an epoch, as
+    /// [`Stopping::CandidateBudget`] does.
+    FixedCandidates,
     /// Stop at the `n`-th accepted candidate. Biased toward high-affinity directions (the
     /// talk's "families until n boys"); offered only to measure that bias.
     AtN,
@@ -222,7 +228,7 @@ impl std::fmt::Display for BatchConfigError {
             BatchConfigError::ZeroCandidateCap => write!(f, "candidate cap must be at least 1"),
             BatchConfigError::BudgetNeedsFrozenMap => write!(
                 f,
-                "the candidate-budget stopping rule needs epochs or a fixed map, not continuous learning"
+                "the candidate-budget and fixed-candidates stopping rules need epochs or a fixed map, not continuous learning"
             ),
             BatchConfigError::BadEpochCount(n) => write!(
                 f,
@@ -275,8 +281,10 @@ impl<V: Value> Batch<V> {
         if config.candidate_cap == 0 {
             return Err(BatchConfigError::ZeroCandidateCap);
         }
-        if config.stopping == Stopping::CandidateBudget
-            && config.affinity.is_some()
+        if matches!(
+            config.stopping,
+            Stopping::CandidateBudget | Stopping::FixedCandidates
+        ) && config.affinity.is_some()
             && config.learning == Learning::Continuous
         {
             return Err(BatchConfigError::BudgetNeedsFrozenMap);
@@ -385,6 +393,7 @@ impl<V: Value> Batch<V> {
                 EpochPlan::doubling(n, epochs)
             }
             (_, Stopping::CandidateBudget) => EpochPlan::doubling(n, 4),
+            (_, Stopping::FixedCandidates) => EpochPlan::single(n),
             _ => EpochPlan::single(n),
         };
         if self.deferred.capacity() < n as usize {
@@ -431,6 +440,7 @@ impl<V: Value> Batch<V> {
                     / (self.previous_epoch_candidates + 1) as f64;
                 ((size as f64 / rate).ceil() as u32).clamp(size, cap)
             }
+            Stopping::FixedCandidates => size,
             Stopping::DropLast | Stopping::AtN => cap,
         };
     }
@@ -445,7 +455,10 @@ impl<V: Value> Batch<V> {
             "Batch::record must follow a Decision::Trace before the next candidate"
         );
         if !self.done && self.epoch_candidates >= self.epoch_limit {
-            if self.config.stopping != Stopping::CandidateBudget {
+            if !matches!(
+                self.config.stopping,
+                Stopping::CandidateBudget | Stopping::FixedCandidates
+            ) {
                 self.batch_stats.cap_hits += 1;
             }
             self.close_epoch();

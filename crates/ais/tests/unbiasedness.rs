@@ -110,6 +110,16 @@ fn epochs_with_halton_placement_and_candidate_budget_are_unbiased() {
     assert_all_within(&results, 4.0);
 }
 
+#[test]
+fn epochs_with_halton_placement_and_fixed_candidates_are_unbiased() {
+    let results = measure_grid(
+        Learning::Epochs { epochs: 4 },
+        Placement::Halton,
+        Stopping::FixedCandidates,
+    );
+    assert_all_within(&results, 4.0);
+}
+
 /// The talk's continuous updates are not exactly unbiased in theory (acceptance changes
 /// inside the batch). With independent candidates this grid measured them within ±2.3
 /// standard errors at 10⁴ batches (see BENCHMARKS.md for larger n and other scenes, where

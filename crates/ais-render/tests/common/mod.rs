@@ -55,3 +55,20 @@ pub fn npm_package(test: &str, spec: &str) -> Option<PathBuf> {
     assert!(untar.success(), "the npm tarball {tarball} must unpack");
     Some(dir.join("package"))
 }
+
+/// The repository's `scenes/` folder, with its generated assets made (by
+/// `scenes/make_assets.py`) if they are missing; `Err` says why they could not be.
+pub fn shipped_scenes() -> Result<PathBuf, String> {
+    let folder = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
+    if !folder.join("assets/sky.hdr").exists() {
+        let made = Command::new("python3")
+            .arg(folder.join("make_assets.py"))
+            .status();
+        match made {
+            Ok(status) if status.success() => {}
+            Ok(status) => panic!("scenes/make_assets.py failed: {status}"),
+            Err(e) => return Err(format!("python3 could not be run ({e})")),
+        }
+    }
+    Ok(folder)
+}
