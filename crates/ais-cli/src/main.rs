@@ -192,10 +192,12 @@ fn gather_settings(
     let mut settings = GatherSettings::default();
     let mut strategy = None;
     let mut ais = None;
+    let mut budget = None;
     if let Some(plugin) = plugin.filter(|p| p.kind == "gather") {
         let at = |(line, message): (u32, String)| format!("line {line}: {message}");
         strategy = plugin.string("strategy").map_err(at)?.map(str::to_string);
         ais = plugin.string("ais").map_err(at)?.map(str::to_string);
+        budget = plugin.string("budget").map_err(at)?.map(str::to_string);
         settings.rays = plugin
             .integer("rays", settings.rays as i64)
             .map_err(at)?
@@ -236,7 +238,7 @@ fn gather_settings(
     settings.tol = args.batch.tol.unwrap_or(settings.tol);
     settings.map_height = args.batch.map_res.unwrap_or(settings.map_height);
     settings.guide_fraction = args.batch.guide_fraction.unwrap_or(settings.guide_fraction);
-    if let Some(name) = &args.batch.budget {
+    if let Some(name) = args.batch.budget.as_ref().or(budget.as_ref()) {
         settings.budget = RayBudget::parse(name)
             .ok_or_else(|| format!("unknown budget \"{name}\" (traced, candidates)"))?;
     }
@@ -465,6 +467,10 @@ fn run_render(args: RenderArgs) -> Result<(), String> {
             output.ais_time.as_secs_f64(),
             100.0 * output.ais_time.as_secs_f64() / cpu.max(1e-9),
             ais_render::ais_timer::SAMPLING
+        );
+        println!(
+            "AIS memory   {:.1} KiB per thread (maps, shared maps, guides)",
+            output.ais_memory_per_thread as f64 / 1024.0
         );
     }
     println!("wrote        {}", args.output.display());

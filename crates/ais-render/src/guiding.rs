@@ -111,6 +111,15 @@ impl Guide {
         }
     }
 
+    /// Bytes held by its distributions.
+    pub fn memory_bytes(&self) -> usize {
+        self.distribution.memory_bytes()
+            + self
+                .environment
+                .as_ref()
+                .map_or(0, EnvironmentGuide::memory_bytes)
+    }
+
     /// How the batch at `at` follows `map` (level 0): strategies that sample lights in a
     /// scene with an environment map draw it from its exact product with the map
     /// ([`EnvironmentGuide`]); the others mix in a texel distribution whose weights are
@@ -129,7 +138,7 @@ impl Guide {
             (samples_lights, &at.lights.environment)
         {
             if self.environment.as_ref().map(EnvironmentGuide::layout) != Some(layout) {
-                self.environment = Some(EnvironmentGuide::new(environment, layout));
+                self.environment = Some(EnvironmentGuide::new(environment.partition(layout)));
             }
             let guide = self.environment.as_mut().expect("just built");
             guide.set_fraction(fraction as f64);

@@ -47,6 +47,23 @@ pub struct SampleContext {
     pub guide: Option<crate::guiding::Guide>,
 }
 
+impl SampleContext {
+    /// Bytes of AIS state this context holds: the batch's map and observations, the shared
+    /// maps of the tile's recent gathers and the guides.
+    pub fn ais_memory_bytes(&self) -> usize {
+        let batch = self.batch.as_ref().map_or(0, |b| {
+            b.map().map_or(0, ais::AffinityMap::memory_bytes)
+                + b.observations().map_or(0, ais::AffinityMap::memory_bytes)
+        });
+        batch
+            + self.shared.memory_bytes()
+            + self
+                .guide
+                .as_ref()
+                .map_or(0, crate::guiding::Guide::memory_bytes)
+    }
+}
+
 /// What to compute at each camera sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Integrator {

@@ -40,6 +40,9 @@ pub struct RenderOutput {
     pub traced_per_sample: Vec<f32>,
     /// Wall time of the render loop.
     pub time: Duration,
+    /// The most AIS state (maps, shared maps, guides) any one tile held, in bytes: what a
+    /// thread needs on top of the scene.
+    pub ais_memory_per_thread: usize,
 }
 
 /// The seed of pixel (x, y) of a `width`-wide image.
@@ -78,6 +81,7 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
         RayCounts,
         ais::Stats,
         Duration,
+        usize,
     );
     let results: Vec<TileResult> = tiles
         .par_iter()
@@ -116,7 +120,17 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
                 .map(|b| *b.stats())
                 .unwrap_or_default();
             let ais_time = context.ais_timer.estimate();
-            (x0, y0, pixels, traced, context.counts, stats, ais_time)
+            let memory = context.ais_memory_bytes();
+            (
+                x0,
+                y0,
+                pixels,
+                traced,
+                context.counts,
+                stats,
+                ais_time,
+                memory,
+            )
         })
         .collect();
     progress.finish_and_clear();
@@ -125,7 +139,9 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
     let mut ais_stats = ais::Stats::default();
     let mut traced_per_sample = vec![0.0; width * height];
     let mut ais_time = Duration::ZERO;
-    for (x0, y0, pixels, traced, counts, stats, time) in results {
+    let mut ais_memory_per_thread = 0;
+    for (x0, y0, pixels, traced, counts, stats, time, memory) in results {
+        ais_memory_per_thread = ais_memory_per_thread.max(memory);
         rays.merge(counts);
         ais_time += time;
         ais_stats.merge(&stats);
@@ -143,5 +159,6 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
         ais_time,
         traced_per_sample,
         time: started.elapsed(),
+        ais_memory_per_thread,
     }
 }

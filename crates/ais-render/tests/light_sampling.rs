@@ -186,7 +186,7 @@ fn environment_guided_by_an_affinity_map_fits() {
     let rotation = DMat3::from_rotation_x(0.5) * DMat3::from_rotation_z(0.3);
     let map = EnvironmentMap::new(gradient_with_sun(64, 32), rotation);
     let layout = LatLong::new(4);
-    let mut guide = EnvironmentGuide::new(&map, layout);
+    let mut guide = EnvironmentGuide::new(map.partition(layout));
     // Uneven affinities, the sun's texel among the smallest.
     let sun_texel = layout.texel(map.brightest_direction());
     guide.set_affinities(|t| {

@@ -46,6 +46,12 @@ impl TexelDistribution {
         distribution
     }
 
+    /// Bytes held by its tables.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self)
+            + 4 * (self.row_cosines.len() + self.cdf.len() + self.density.len())
+    }
+
     /// The layout.
     pub fn layout(&self) -> LatLong {
         self.layout

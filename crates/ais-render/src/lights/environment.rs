@@ -43,6 +43,8 @@ pub struct EnvironmentMap {
     /// cos θ of each texel row.
     row_cosines: Vec<f64>,
     mean_luminance: f64,
+    /// Its cells grouped by map texels, for guided light sampling.
+    partitions: super::environment_guide::PartitionCache,
 }
 
 impl EnvironmentMap {
@@ -81,6 +83,7 @@ impl EnvironmentMap {
             image,
             row_cosines,
             mean_luminance: integral / (4.0 * PI),
+            partitions: Default::default(),
         }
     }
 
@@ -150,6 +153,14 @@ impl EnvironmentMap {
 
     fn pdf(&self, direction: Vec3) -> f64 {
         self.pdf_and_cell(direction).0
+    }
+
+    /// Its cells grouped by the texels of `layout` (built once, then shared).
+    pub fn partition(
+        &self,
+        layout: ais::mapping::LatLong,
+    ) -> std::sync::Arc<super::EnvironmentPartition> {
+        self.partitions.get(self, layout)
     }
 
     /// The centre of the cell that sampling picks most often (the sun, in a sky).

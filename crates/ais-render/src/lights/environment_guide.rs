@@ -14,10 +14,12 @@
 use super::EnvironmentMap;
 use ais::mapping::{LatLong, Texel};
 use glam::Vec3;
+use std::sync::{Arc, Mutex};
 
-/// The environment's cells grouped by map texel, and the product distribution of one batch.
-#[derive(Clone, Debug)]
-pub struct EnvironmentGuide {
+/// The environment's cells grouped by the texels of one map layout: built once per
+/// environment and layout, shared by every thread ([`EnvironmentMap::partition`]).
+#[derive(Debug)]
+pub struct EnvironmentPartition {
     layout: LatLong,
     /// The map texel of every environment cell.
     cell_texel: Vec<u32>,
@@ -29,17 +31,11 @@ pub struct EnvironmentGuide {
     within: Vec<f64>,
     /// `P_t`: the environment's probability of each texel.
     texel_mass: Vec<f64>,
-    /// Per batch: the affinity of each texel, the cumulative of `A_t P_t / Z`, and `Z`.
-    affinity: Vec<f32>,
-    cdf: Vec<f64>,
-    normaliser: f64,
-    /// The product's share β of the defensive mixture `(1 − β) p_env + β p_env A / Z`.
-    fraction: f64,
 }
 
-impl EnvironmentGuide {
+impl EnvironmentPartition {
     /// Groups the cells of `environment` by the texels of `layout` (map directions are world
-    /// directions). The product starts as the environment's own distribution (all A = 1).
+    /// directions), each cell by the texel of its centre.
     pub fn new(environment: &EnvironmentMap, layout: LatLong) -> Self {
         let texels = layout.texel_count();
         let cell_texel: Vec<u32> = (0..environment.cell_count())
@@ -72,13 +68,78 @@ impl EnvironmentGuide {
                 within[range].iter_mut().for_each(|c| *c /= running);
             }
         }
-        let mut guide = EnvironmentGuide {
+        EnvironmentPartition {
             layout,
             cell_texel,
             cells,
             start,
             within,
             texel_mass,
+        }
+    }
+
+    /// The map layout the cells are grouped by.
+    pub fn layout(&self) -> LatLong {
+        self.layout
+    }
+
+    /// Bytes held by its tables (about 16 per environment cell).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self)
+            + 4 * (self.cell_texel.len() + self.cells.len() + self.start.len())
+            + 8 * (self.within.len() + self.texel_mass.len())
+    }
+}
+
+/// The partitions built for an environment, one per layout, shared by all threads. Cloning
+/// an environment starts an empty cache.
+#[derive(Debug, Default)]
+pub(crate) struct PartitionCache(Mutex<Vec<Arc<EnvironmentPartition>>>);
+
+impl Clone for PartitionCache {
+    fn clone(&self) -> Self {
+        PartitionCache::default()
+    }
+}
+
+impl PartitionCache {
+    /// The partition of `environment` by `layout`, built on first use.
+    pub(crate) fn get(
+        &self,
+        environment: &EnvironmentMap,
+        layout: LatLong,
+    ) -> Arc<EnvironmentPartition> {
+        // A panic while building poisons nothing we rely on: the list stays valid.
+        let mut built = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(partition) = built.iter().find(|p| p.layout == layout) {
+            return partition.clone();
+        }
+        let partition = Arc::new(EnvironmentPartition::new(environment, layout));
+        built.push(partition.clone());
+        partition
+    }
+}
+
+/// The product distribution of one batch: a shared [`EnvironmentPartition`] and the
+/// affinities of the batch's map.
+#[derive(Clone, Debug)]
+pub struct EnvironmentGuide {
+    partition: Arc<EnvironmentPartition>,
+    /// Per batch: the affinity of each texel, the cumulative of `A_t P_t / Z`, and `Z`.
+    affinity: Vec<f32>,
+    cdf: Vec<f64>,
+    normaliser: f64,
+    /// The product's share β of the defensive mixture `(1 − β) p_env + β p_env A / Z`.
+    fraction: f64,
+}
+
+impl EnvironmentGuide {
+    /// A guide over `partition`; the product starts as the environment's own distribution
+    /// (all A = 1).
+    pub fn new(partition: Arc<EnvironmentPartition>) -> Self {
+        let texels = partition.layout.texel_count();
+        let mut guide = EnvironmentGuide {
+            partition,
             affinity: vec![1.0; texels],
             cdf: vec![0.0; texels + 1],
             normaliser: 1.0,
@@ -88,9 +149,15 @@ impl EnvironmentGuide {
         guide
     }
 
+    /// Bytes held by this thread's part (the shared partition is counted once, in
+    /// [`EnvironmentPartition::memory_bytes`]).
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of_val(self) + 4 * self.affinity.len() + 8 * self.cdf.len()
+    }
+
     /// The map layout the cells are grouped by.
     pub fn layout(&self) -> LatLong {
-        self.layout
+        self.partition.layout
     }
 
     /// Sets the affinity `A_t` of every texel for the next batch. The product has density
@@ -100,16 +167,16 @@ impl EnvironmentGuide {
     pub fn set_affinities(&mut self, affinity: impl Fn(Texel) -> f32) {
         let mut running = 0.0;
         for t in 0..self.affinity.len() {
-            let a = affinity(self.layout.texel_of_index(t));
+            let a = affinity(self.partition.layout.texel_of_index(t));
             self.affinity[t] = if a.is_finite() && a > 0.0 { a } else { 0.0 };
-            running += self.affinity[t] as f64 * self.texel_mass[t];
+            running += self.affinity[t] as f64 * self.partition.texel_mass[t];
             self.cdf[t + 1] = running;
         }
         if running <= 0.0 {
             self.affinity.fill(1.0);
             running = 0.0;
             for t in 0..self.affinity.len() {
-                running += self.texel_mass[t];
+                running += self.partition.texel_mass[t];
                 self.cdf[t + 1] = running;
             }
         }
@@ -141,22 +208,24 @@ impl EnvironmentGuide {
         }
         let share = self.cdf[t + 1] - self.cdf[t];
         let v = ((u0 - self.cdf[t]) / share).clamp(0.0, 1.0);
-        let range = self.start[t] as usize..self.start[t + 1] as usize;
-        let within = &self.within[range.clone()];
+        let partition = &*self.partition;
+        let range = partition.start[t] as usize..partition.start[t + 1] as usize;
+        let within = &partition.within[range.clone()];
         let mut i = within.partition_point(|&c| c <= v).min(within.len() - 1);
         while i > 0 && within[i] <= within[i - 1] {
             i -= 1;
         }
         let below = if i == 0 { 0.0 } else { within[i - 1] };
         let fx = ((v - below) / (within[i] - below)).clamp(0.0, 1.0 - 1e-9);
-        let cell = self.cells[range.start + i] as usize;
+        let cell = partition.cells[range.start + i] as usize;
         environment.direction_in_cell(cell, [fx, (u[1] as f64).min(1.0 - 1e-9)])
     }
 
     /// The mixture's density at `direction` (solid angle).
     pub fn pdf(&self, environment: &EnvironmentMap, direction: Vec3) -> f64 {
         let (density, cell) = environment.pdf_and_cell(direction);
-        let product = self.affinity[self.cell_texel[cell] as usize] as f64 / self.normaliser;
+        let product =
+            self.affinity[self.partition.cell_texel[cell] as usize] as f64 / self.normaliser;
         density * ((1.0 - self.fraction) + self.fraction * product)
     }
 }

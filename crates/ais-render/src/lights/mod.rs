@@ -8,7 +8,7 @@ mod spherical_rectangle;
 
 pub use area::{AreaLight, AreaSample, AreaShape};
 pub use environment::{luminance, Environment, EnvironmentMap};
-pub use environment_guide::EnvironmentGuide;
+pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
 pub use spherical_rectangle::Rectangle;
 
 use crate::distribution::Distribution1D;

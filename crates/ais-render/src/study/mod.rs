@@ -149,6 +149,8 @@ pub struct Run {
     pub stats: ais::Stats,
     /// relMSE after every pass.
     pub curve: Vec<CurvePoint>,
+    /// The most AIS state one thread held (bytes).
+    pub ais_memory_per_thread: usize,
 }
 
 impl Run {
@@ -216,6 +218,7 @@ fn progressive(
         rays: RayCounts::default(),
         stats: ais::Stats::default(),
         curve: Vec::new(),
+        ais_memory_per_thread: 0,
     };
     loop {
         let output = render(
@@ -236,6 +239,7 @@ fn progressive(
         run.seconds += output.time.as_secs_f64();
         run.rays.merge(output.rays);
         run.stats.merge(&output.ais);
+        run.ais_memory_per_thread = run.ais_memory_per_thread.max(output.ais_memory_per_thread);
         for (pixel, s) in run.image.pixels.iter_mut().zip(&sum) {
             *pixel = s.map(|v| (v / run.spp as f64) as f32);
         }

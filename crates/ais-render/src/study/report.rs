@@ -86,18 +86,20 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
         context.seeds,
         results.reference.noise_floor()
     );
-    out.push_str("| configuration | spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | relMSE | ratio |\n|---|---|---|---|---|---|---|\n");
+    out.push_str("| configuration | spp | ms per pass | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio |\n|---|---|---|---|---|---|---|---|---|\n");
     for row in rows.iter().filter(|r| !r.result.equal_time.is_empty()) {
         let runs = &row.result.equal_time;
         let spp = average(runs, |r| r.spp as f64);
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.0} | {:.1} | {:.1} | {:.3e} ± {:.1e} | {:.2}× |",
+            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {:.3e} ± {:.1e} | {:.2}× |",
             row.result.configuration.name,
             spp,
+            1e3 * average(runs, |r| r.seconds) / spp,
             spp * context.rays as f64,
             average(runs, |r| r.rays.occlusion as f64) / pixels,
             average(runs, |r| r.stats.rejected_roulette as f64) / pixels,
+            average(runs, |r| r.ais_memory_per_thread as f64) / 1024.0,
             row.time_rel_mse.0,
             row.time_rel_mse.1,
             base.time_rel_mse.0 / row.time_rel_mse.0
