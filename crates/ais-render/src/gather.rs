@@ -149,7 +149,8 @@ impl Acceptance {
         )
     }
 
-    /// The acceptance probability for affinity `q`, value `v` and earlier mean `mean`.
+    /// The acceptance probability for affinity `q`, value `v` and earlier mean `mean`
+    /// (`v` and `mean` matter only to the rules that [`Acceptance::needs_value`]).
     fn probability(self, q: f32, v: f32, mean: Option<f32>) -> f32 {
         match (self, mean) {
             (Acceptance::Affinity, _) => q,
@@ -214,23 +215,19 @@ impl GatherSettings {
                 learning: ais::Learning::Off,
                 ..base
             },
-            AisMode::Shared | AisMode::Guided => BatchConfig {
+            AisMode::Shared | AisMode::Guided | AisMode::Warm => BatchConfig {
                 affinity: Some(MapConfig {
                     height: self.map_height,
                     tol: self.tol,
                     ..MapConfig::default()
                 }),
-                // The blended map is held fixed: exactly unbiased.
-                learning: ais::Learning::Off,
-                ..base
-            },
-            AisMode::Warm => BatchConfig {
-                affinity: Some(MapConfig {
-                    height: self.map_height,
-                    tol: self.tol,
-                    ..MapConfig::default()
-                }),
-                learning: ais::Learning::Epochs { epochs: 4 },
+                // Shared and guided hold the blended map fixed (exactly unbiased); warm
+                // keeps learning from it in frozen-map epochs.
+                learning: if self.ais == AisMode::Warm {
+                    ais::Learning::Epochs { epochs: 4 }
+                } else {
+                    ais::Learning::Off
+                },
                 ..base
             },
             AisMode::Aggressive | AisMode::Conservative => BatchConfig {
@@ -431,10 +428,10 @@ pub fn run_batch(
         } else if settings.ais == AisMode::Guided {
             // The map is already in the proposal: trace every candidate.
             batch.decide_with(direction, in_support, |_| 1.0)
-        } else if settings.acceptance == Acceptance::SqrtAffinity {
-            batch.decide_with(direction, in_support, f32::sqrt)
         } else {
-            batch.decide(direction, in_support)
+            batch.decide_with(direction, in_support, |affinity| {
+                settings.acceptance.probability(affinity, 0.0, None)
+            })
         };
         if let Decision::Trace { .. } = decision {
             let (pdf, ray) = known

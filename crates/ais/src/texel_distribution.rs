@@ -42,7 +42,7 @@ impl TexelDistribution {
             cdf: vec![0.0; layout.texel_count() + 1],
             density: vec![0.0; layout.texel_count()],
         };
-        distribution.set_weights(|texel| solid_angle_weight(layout, texel));
+        distribution.set_weights(|texel| layout.texel_solid_angle(texel.row));
         distribution
     }
 
@@ -72,7 +72,7 @@ impl TexelDistribution {
         }
         let layout = self.layout;
         // Solid angles are positive: this fill succeeds.
-        self.fill(&mut |texel| solid_angle_weight(layout, texel));
+        self.fill(&mut |texel| layout.texel_solid_angle(texel.row));
         false
     }
 
@@ -171,11 +171,6 @@ impl TexelDistribution {
     pub fn pdf(&self, direction: Vec3) -> f32 {
         self.density[self.layout.index(self.texel_of(direction))]
     }
-}
-
-/// The weight that makes a texel distribution uniform over the sphere: its solid angle.
-fn solid_angle_weight(layout: LatLong, texel: Texel) -> f32 {
-    layout.texel_solid_angle(texel.row)
 }
 
 #[cfg(test)]

@@ -188,10 +188,7 @@ impl EnvironmentMap {
 
     /// The world direction through the centre of `cell`.
     pub(crate) fn cell_centre(&self, cell: usize) -> Vec3 {
-        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
-        let x = ((cell % width) as f64 + 0.5) / width as f64;
-        let y = ((cell / width) as f64 + 0.5) / rows as f64;
-        self.direction_at([x, y]).0
+        self.direction_in_cell(cell, [0.5, 0.5])
     }
 
     /// The direction at fractions (`fx`, `fy`) ∈ [0, 1)² of `cell`'s azimuth and cos θ range:
