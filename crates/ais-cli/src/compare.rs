@@ -29,8 +29,9 @@ pub struct CompareArgs {
     /// of configurations by every strategy × AIS mode (and the oracle).
     #[arg(long, value_delimiter = ',')]
     strategies: Vec<String>,
-    /// AIS modes to compare (off, aggressive, conservative, shared, warm, guided; +sqrt, +value or +efficient
-    /// for value-aware acceptance, e.g. shared+efficient); see --strategies.
+    /// AIS modes to compare (off, aggressive, conservative, shared, warm, guided; +sqrt,
+    /// +value or +efficient for another acceptance rule, e.g. shared+efficient; @tile or
+    /// @pass[:S] for where shared maps come from, e.g. shared@pass:8); see --strategies.
     #[arg(long, value_delimiter = ',')]
     ais: Vec<String>,
     /// Leave out the oracle (with --ais; it traces every candidate, so it is slow).
@@ -44,6 +45,10 @@ pub struct CompareArgs {
     /// Samples per pixel of the reference (cached in the report's cache/ folder).
     #[arg(long, default_value_t = 256)]
     reference_spp: u32,
+    /// Samples per pixel of each progressive pass (one render call; per-render costs such as
+    /// the learning pass of shared maps are spread over them).
+    #[arg(long, default_value_t = 1)]
+    pass_spp: u32,
     /// The pixel of the affinity-map figure, x,y (default: the image centre).
     #[arg(long, value_parser = parse_pixel)]
     pixel: Option<(u32, u32)>,
@@ -91,7 +96,7 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
             format!("unknown strategy \"{strategy_name}\" (uniform, bsdf, light, mis)")
         })?;
         for mode_name in &modes {
-            let (ais, acceptance) = parse_ais(mode_name)?;
+            let (ais, acceptance, sharing) = parse_ais(mode_name)?;
             if ais == AisMode::Oracle {
                 return Err("the oracle is always added; leave it out of --ais".into());
             }
@@ -103,6 +108,7 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
                     strategy,
                     ais,
                     acceptance,
+                    sharing: sharing.unwrap_or(base.sharing),
                     ..base
                 },
             ));
@@ -130,8 +136,8 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
     if !(args.time_budget > 0.0 && args.time_budget.is_finite()) {
         return Err("--time-budget must be a positive number of seconds".into());
     }
-    if args.seeds == 0 || args.reference_spp == 0 {
-        return Err("--seeds and --reference-spp must be at least 1".into());
+    if args.seeds == 0 || args.reference_spp == 0 || args.pass_spp == 0 {
+        return Err("--seeds, --reference-spp and --pass-spp must be at least 1".into());
     }
     let world = load_world(
         args.scene.as_deref(),
@@ -174,6 +180,7 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
         time_budget: Duration::from_secs_f64(args.time_budget),
         seeds: args.seeds,
         reference_spp: args.reference_spp,
+        pass_spp: args.pass_spp,
         reference_cache: Some(reference::cache_paths(&args.output.join("cache"), &key)),
         figure_pixel: pixel,
         progress: !args.quiet && std::io::stderr().is_terminal(),

@@ -1,7 +1,7 @@
 //! The `ais` command.
 
 use ais_render::default_scene::default_world;
-use ais_render::gather::{Acceptance, AisMode, GatherSettings, RayBudget};
+use ais_render::gather::{Acceptance, AisMode, GatherSettings, RayBudget, Sharing};
 use ais_render::image_io::RgbImage;
 use ais_render::image_io::{write_exr, write_png};
 use ais_render::integrator::Integrator;
@@ -113,7 +113,8 @@ struct RenderArgs {
     /// proposal: nothing rejected), or oracle (a bound for studies: the
     /// proposal restricted to directions that bring light, found by free brute-force tests).
     /// Append +sqrt (accept with √affinity), or +value or +efficient for value-aware
-    /// acceptance (e.g. shared+efficient).
+    /// acceptance (e.g. shared+efficient); then @tile or @pass[:S] for where shared maps
+    /// come from (see --sharing; e.g. shared@pass).
     #[arg(long)]
     ais: Option<String>,
     /// Acceptance rule: affinity (the talk's), sqrt (√affinity), value (always trace
@@ -171,6 +172,11 @@ struct BatchArgs {
     /// candidates (AIS traces only the accepted ones: cheaper gathers).
     #[arg(long)]
     budget: Option<String>,
+    /// Where shared, warm and guided gathers find their neighbours' maps: tile (the gathers
+    /// before them in their tile's order) or pass (a learning pass of AIS-off gathers, one
+    /// per 4×4 pixels, around each tile; pass:S for S×S blocks, S in 1..=16).
+    #[arg(long)]
+    sharing: Option<String>,
 }
 
 /// Gather flags given on the command line (None: not given).
@@ -193,11 +199,13 @@ fn gather_settings(
     let mut strategy = None;
     let mut ais = None;
     let mut budget = None;
+    let mut sharing = None;
     if let Some(plugin) = plugin.filter(|p| p.kind == "gather") {
         let at = |(line, message): (u32, String)| format!("line {line}: {message}");
         strategy = plugin.string("strategy").map_err(at)?.map(str::to_string);
         ais = plugin.string("ais").map_err(at)?.map(str::to_string);
         budget = plugin.string("budget").map_err(at)?.map(str::to_string);
+        sharing = plugin.string("sharing").map_err(at)?.map(str::to_string);
         settings.rays = plugin
             .integer("rays", settings.rays as i64)
             .map_err(at)?
@@ -215,9 +223,10 @@ fn gather_settings(
             .ok_or_else(|| format!("unknown strategy \"{name}\" (uniform, bsdf, light, mis)"))?;
     }
     if let Some(name) = ais {
-        let (mode, acceptance) = parse_ais(&name)?;
+        let (mode, acceptance, sharing) = parse_ais(&name)?;
         settings.ais = mode;
         settings.acceptance = acceptance;
+        settings.sharing = sharing.unwrap_or(settings.sharing);
     }
     if let Some(name) = &args.acceptance {
         settings.acceptance = Acceptance::parse(name).ok_or_else(|| {
@@ -242,6 +251,11 @@ fn gather_settings(
         settings.budget = RayBudget::parse(name)
             .ok_or_else(|| format!("unknown budget \"{name}\" (traced, candidates)"))?;
     }
+    if let Some(name) = args.batch.sharing.as_ref().or(sharing.as_ref()) {
+        settings.sharing = Sharing::parse(name).ok_or_else(|| {
+            format!("unknown sharing \"{name}\" (tile, pass, or pass:S with S in 1..=16)")
+        })?;
+    }
     if !(0.0..=0.99).contains(&settings.guide_fraction) {
         return Err("--guide-fraction must lie in [0, 0.99]".into());
     }
@@ -258,15 +272,24 @@ fn gather_settings(
 }
 
 /// An AIS mode name, optionally with "+sqrt", "+value" or "+efficient" for another
-/// acceptance rule.
-fn parse_ais(name: &str) -> Result<(AisMode, Acceptance), String> {
-    let (mode, rule) = name.split_once('+').unwrap_or((name, ""));
-    match (AisMode::parse(mode), Acceptance::parse(rule)) {
-        (Some(mode), Some(acceptance)) => Ok((mode, acceptance)),
-        _ => Err(format!(
+/// acceptance rule, then optionally "@tile" or "@pass[:S]" for where a mode that shares maps
+/// finds them (e.g. shared+sqrt@pass:8).
+fn parse_ais(name: &str) -> Result<(AisMode, Acceptance, Option<Sharing>), String> {
+    let unknown = || {
+        format!(
             "unknown AIS mode \"{name}\" (off, aggressive, conservative, shared, warm, guided, oracle; \
-             +sqrt, +value or +efficient for another acceptance rule, e.g. shared+sqrt)"
-        )),
+             +sqrt, +value or +efficient for another acceptance rule, e.g. shared+sqrt; \
+             @tile, @pass or @pass:S for where shared maps come from, e.g. shared@pass:8)"
+        )
+    };
+    let (rest, sharing) = match name.split_once('@') {
+        Some((rest, sharing)) => (rest, Some(Sharing::parse(sharing).ok_or_else(unknown)?)),
+        None => (name, None),
+    };
+    let (mode, rule) = rest.split_once('+').unwrap_or((rest, ""));
+    match (AisMode::parse(mode), Acceptance::parse(rule)) {
+        (Some(mode), Some(acceptance)) => Ok((mode, acceptance, sharing)),
+        _ => Err(unknown()),
     }
 }
 

@@ -9,7 +9,7 @@ use crate::guiding::{Guidance, Guide, Proposal};
 use crate::integrator::{RayCounts, SampleContext};
 use crate::lights::luminance;
 use crate::proposal::{GatherPoint, Strategy};
-use crate::shared_maps::RADIUS_PIXELS;
+use crate::shared_maps::{blend_neighbours, RADIUS_PIXELS};
 use crate::world::World;
 use ais::rng::Pcg32;
 use ais::{rating, Batch, BatchConfig, Decision, MapConfig, MapStart, Mode, Stopping};
@@ -79,6 +79,46 @@ pub struct GatherSettings {
     /// What `rays` counts: traced rays (AIS draws extra candidates to trace about `rays`)
     /// or candidates (AIS traces fewer and the gather gets cheaper).
     pub budget: RayBudget,
+    /// Where shared, warm and guided gathers find their neighbours' maps.
+    pub sharing: Sharing,
+}
+
+/// Where the modes that share maps ([`GatherSettings::shares_maps`]) take the maps of
+/// neighbouring gather points from. Both keep the image independent of threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sharing {
+    /// The gathers before it in its tile, in the tile's fixed pixel order (see
+    /// [`crate::shared_maps`]): free, but one-sided, and a tile's first gathers have none.
+    TileOrder,
+    /// A learning pass: AIS-off gathers at the centres of `stride × stride` pixel blocks
+    /// over the tile and one block around it, run before the tile (see
+    /// [`crate::learning_pass`]): neighbours on every side, for extra gathers.
+    LearningPass {
+        /// Block edge in pixels (1 to [`crate::render::TILE_SIZE`]).
+        stride: u32,
+    },
+}
+
+/// The learning pass's default block edge, in pixels.
+pub const LEARNING_STRIDE: u32 = 4;
+
+impl Sharing {
+    /// Parses "tile", "pass" (blocks of [`LEARNING_STRIDE`]) or "pass:S" (blocks of S
+    /// pixels).
+    pub fn parse(name: &str) -> Option<Sharing> {
+        match name.split_once(':') {
+            None if name == "tile" => Some(Sharing::TileOrder),
+            None if name == "pass" => Some(Sharing::LearningPass {
+                stride: LEARNING_STRIDE,
+            }),
+            Some(("pass", stride)) => stride
+                .parse()
+                .ok()
+                .filter(|s| (1..=crate::render::TILE_SIZE as u32).contains(s))
+                .map(|stride| Sharing::LearningPass { stride }),
+            _ => None,
+        }
+    }
 }
 
 /// What a gather's `rays` counts.
@@ -193,11 +233,18 @@ impl Default for GatherSettings {
             // set beat the traced budget's 4 separately scrambled epochs by 1.27-1.57× at
             // equal time on every scene, and shared maps gain only with this budget.
             budget: RayBudget::Candidates,
+            sharing: Sharing::TileOrder,
         }
     }
 }
 
 impl GatherSettings {
+    /// Whether each gather starts from maps learned at neighbouring gather points (shared,
+    /// warm and guided).
+    pub fn shares_maps(&self) -> bool {
+        matches!(self.ais, AisMode::Shared | AisMode::Warm | AisMode::Guided)
+    }
+
     /// The batch configuration. Every mode uses the candidate-budget stopping rule, which is
     /// exactly unbiased with Halton placement even when candidates fall outside the support.
     pub fn batch_config(&self) -> BatchConfig {
@@ -330,12 +377,10 @@ pub fn gather(
         batch,
         ais_timer,
         shared,
+        learned,
         guide,
     } = context;
-    let sharing = matches!(
-        settings.ais,
-        AisMode::Shared | AisMode::Warm | AisMode::Guided
-    );
+    let sharing = settings.shares_maps();
     let batch = batch.get_or_insert_with(|| {
         let mut batch = Batch::new(settings.batch_config()).expect("valid gather configuration");
         batch.observe_rays(sharing);
@@ -344,9 +389,23 @@ pub fn gather(
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     let mut proposal = Proposal::plain(settings.strategy);
     let start = if sharing {
-        let radius = RADIUS_PIXELS * hit.t * world.camera.pixel_angle(world.resolution.0);
+        let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
         let map = batch.map_mut().expect("shared mode has a map");
-        let neighbours = shared.load_into(map, hit.point, at.frame.normal, radius);
+        let (point, normal) = (hit.point, at.frame.normal);
+        let tile_order = (shared.neighbours(), RADIUS_PIXELS * footprint);
+        let neighbours = match settings.sharing {
+            Sharing::TileOrder => blend_neighbours(map, &[tile_order], point, normal),
+            // The pass gives neighbours on all sides; the tile's earlier gathers add theirs.
+            Sharing::LearningPass { stride } => blend_neighbours(
+                map,
+                &[
+                    tile_order,
+                    (learned.neighbours(), stride as f32 * footprint),
+                ],
+                point,
+                normal,
+            ),
+        };
         if settings.ais == AisMode::Guided && neighbours > 0 {
             let guide = guide.get_or_insert_with(|| Guide::new(settings.map_height));
             match guide.prepare(map, settings.strategy, &at, settings.guide_fraction) {

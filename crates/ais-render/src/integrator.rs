@@ -1,7 +1,7 @@
 //! What a camera sample computes: the AIS gather (see [`crate::gather`]), or shading
 //! normals and ambient occlusion for checking geometry; and the per-thread state they share.
 
-use crate::gather::{gather, GatherSettings};
+use crate::gather::{gather, GatherSettings, Sharing};
 use crate::geometry::{basis, cosine_hemisphere, spawn_ray, Ray};
 use crate::world::World;
 use ais::rng::Pcg32;
@@ -41,15 +41,44 @@ pub struct SampleContext {
     pub batch: Option<Batch<[f32; 3]>>,
     /// Time spent in AIS calls (sampled).
     pub ais_timer: crate::ais_timer::AisTimer,
-    /// The recent gathers of this tile, for shared maps.
+    /// The recent gathers of this tile, for shared maps in tile order.
     pub shared: crate::shared_maps::SharedMaps,
+    /// The learning pass around this tile, for shared maps from a learning pass.
+    pub learned: crate::learning_pass::LearningPass,
     /// The guide distribution of guided gathers (allocated on first use).
     pub guide: Option<crate::guiding::Guide>,
 }
 
 impl SampleContext {
+    /// Prepares for the tile `tile` of a `width × height` image rendered with `integrator`
+    /// and base seed `seed`: runs its learning pass, if the gather shares maps from one.
+    pub fn begin_tile(
+        &mut self,
+        world: &World,
+        integrator: &Integrator,
+        seed: u64,
+        tile: crate::learning_pass::PixelRect,
+        size: (usize, usize),
+    ) {
+        if let Integrator::Gather(settings) = integrator {
+            if let (true, Sharing::LearningPass { stride }) =
+                (settings.shares_maps(), settings.sharing)
+            {
+                self.learned.learn(
+                    world,
+                    settings,
+                    stride as usize,
+                    seed,
+                    tile,
+                    size,
+                    &mut self.counts,
+                );
+            }
+        }
+    }
+
     /// Bytes of AIS state this context holds: the batch's map and observations, the shared
-    /// maps of the tile's recent gathers and the guides.
+    /// maps of the tile's recent gathers or of its learning pass, and the guides.
     pub fn ais_memory_bytes(&self) -> usize {
         let batch = self.batch.as_ref().map_or(0, |b| {
             b.map().map_or(0, ais::AffinityMap::memory_bytes)
@@ -57,6 +86,7 @@ impl SampleContext {
         });
         batch
             + self.shared.memory_bytes()
+            + self.learned.memory_bytes()
             + self
                 .guide
                 .as_ref()

@@ -21,6 +21,7 @@ pub mod geometry;
 pub mod guiding;
 pub mod image_io;
 pub mod integrator;
+pub mod learning_pass;
 pub mod lights;
 pub mod mesh;
 pub mod oracle;

@@ -4,6 +4,7 @@
 use crate::film::Film;
 use crate::image_io::RgbImage;
 use crate::integrator::{Integrator, RayCounts, SampleContext};
+use crate::learning_pass::PixelRect;
 use crate::world::World;
 use ais::rng::{mix64, Pcg32};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -87,10 +88,23 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
         .par_iter()
         .map(|&(x0, y0)| {
             let mut context = SampleContext::default();
+            let tile = PixelRect {
+                x0,
+                y0,
+                x1: (x0 + TILE_SIZE).min(width),
+                y1: (y0 + TILE_SIZE).min(height),
+            };
+            context.begin_tile(
+                world,
+                &settings.integrator,
+                settings.seed,
+                tile,
+                (width, height),
+            );
             let mut pixels = Vec::with_capacity(TILE_SIZE * TILE_SIZE);
             let mut traced = Vec::with_capacity(TILE_SIZE * TILE_SIZE);
-            for y in y0..(y0 + TILE_SIZE).min(height) {
-                for x in x0..(x0 + TILE_SIZE).min(width) {
+            for y in tile.y0..tile.y1 {
+                for x in tile.x0..tile.x1 {
                     let mut rng = Pcg32::new(pixel_seed(settings.seed, x, y, width), 0);
                     let traced_before = context.batch.as_ref().map_or(0, |b| b.stats().traced);
                     let mut sum = [0.0f64; 3];

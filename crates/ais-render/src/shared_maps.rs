@@ -10,9 +10,11 @@
 //! estimate is exactly unbiased. Across depth or normal discontinuities the weights vanish
 //! and the map stays fresh (affinity 1, i.e. AIS off). Maps are in world-space directions.
 //!
-//! The memory is per thread, bounded by [`NEIGHBOURS`] maps, and cleared at every tile, so
-//! what a gather sees depends only on the gathers before it in its tile, in the tile's fixed
-//! pixel order: the image is the same for any number of threads.
+//! The memory is per thread, bounded by [`NEIGHBOURS`] maps, and starts empty at every tile,
+//! so what a gather sees depends only on the gathers before it in its tile, in the tile's
+//! fixed pixel order: the image is the same for any number of threads. With
+//! [`crate::gather::Sharing::LearningPass`] the maps of a learning pass around the tile
+//! ([`crate::learning_pass`]) are blended in as well.
 
 use ais::AffinityMap;
 use glam::Vec3;
@@ -24,12 +26,43 @@ pub const RADIUS_PIXELS: f32 = 3.0;
 /// Neighbours weighing less than this are ignored.
 const LEAST_WEIGHT: f32 = 1e-3;
 
-/// One remembered gather.
+/// One finished gather whose observations a later gather may blend.
 #[derive(Clone, Debug)]
-struct Neighbour {
+pub(crate) struct Neighbour {
+    /// Where it gathered.
+    pub point: Vec3,
+    /// Its shading normal.
+    pub normal: Vec3,
+    /// The rays it traced.
+    pub observations: AffinityMap,
+}
+
+/// Sets `map` to the blend of the neighbours near `point` (shading normal `normal`) in
+/// each group of `sources`, a neighbour of a group with radius `r` weighing
+/// `exp(−d²/r²) · max(0, n·n')⁸`; returns how many weighed at least [`LEAST_WEIGHT`]. With
+/// none, `map` is fresh (affinity 1).
+pub(crate) fn blend_neighbours(
+    map: &mut AffinityMap,
+    sources: &[(&[Neighbour], f32)],
     point: Vec3,
     normal: Vec3,
-    observations: AffinityMap,
+) -> usize {
+    let mut count = 0;
+    map.blend_from(
+        sources
+            .iter()
+            .flat_map(|&(neighbours, radius)| {
+                let inverse_r2 = 1.0 / (radius * radius).max(f32::MIN_POSITIVE);
+                neighbours.iter().filter_map(move |neighbour| {
+                    let facing = neighbour.normal.dot(normal).max(0.0);
+                    let weight = (-(neighbour.point - point).length_squared() * inverse_r2).exp()
+                        * facing.powi(8);
+                    (weight >= LEAST_WEIGHT).then_some((&neighbour.observations, weight))
+                })
+            })
+            .inspect(|_| count += 1),
+    );
+    count
 }
 
 /// The recent gathers of one thread's current tile.
@@ -40,33 +73,9 @@ pub struct SharedMaps {
 }
 
 impl SharedMaps {
-    /// Forgets every gather (at the start of a tile).
-    pub fn clear(&mut self) {
-        self.neighbours.clear();
-        self.next = 0;
-    }
-
-    /// Sets `map` to the blend of the remembered gathers near `point` (with shading normal
-    /// `normal`) within `radius`; returns how many contributed. With none, `map` is fresh.
-    pub fn load_into(
-        &self,
-        map: &mut AffinityMap,
-        point: Vec3,
-        normal: Vec3,
-        radius: f32,
-    ) -> usize {
-        let inverse_r2 = 1.0 / (radius * radius).max(f32::MIN_POSITIVE);
-        let mut count = 0;
-        map.blend_from(self.neighbours.iter().filter_map(|neighbour| {
-            let facing = neighbour.normal.dot(normal).max(0.0);
-            let weight =
-                (-(neighbour.point - point).length_squared() * inverse_r2).exp() * facing.powi(8);
-            (weight >= LEAST_WEIGHT).then(|| {
-                count += 1;
-                (&neighbour.observations, weight)
-            })
-        }));
-        count
+    /// The remembered gathers, oldest first or in any order (blending does not care).
+    pub(crate) fn neighbours(&self) -> &[Neighbour] {
+        &self.neighbours
     }
 
     /// Remembers a finished gather's observations, replacing the oldest beyond

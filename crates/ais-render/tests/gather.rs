@@ -4,7 +4,7 @@
 
 mod common;
 
-use ais_render::gather::{Acceptance, AisMode, GatherSettings, RayBudget};
+use ais_render::gather::{Acceptance, AisMode, GatherSettings, RayBudget, Sharing};
 use ais_render::integrator::Integrator;
 use ais_render::proposal::Strategy;
 use ais_render::render::{render, RenderSettings};
@@ -390,15 +390,22 @@ fn every_mode_is_unbiased_with_a_fixed_candidate_budget() {
     let world = occluded_scene();
     let (reference, reference_se, _) =
         pixel_statistics(&world, settings(Strategy::Mis, AisMode::Off, 32), 64, 8);
+    // The 6 × 6 image is one tile: a learning pass with 2-pixel blocks gives every pixel
+    // learned neighbours all around.
+    let pass = Sharing::LearningPass { stride: 2 };
     for strategy in [Strategy::Uniform, Strategy::Mis] {
-        for mode in [
-            AisMode::Off,
-            AisMode::Aggressive,
-            AisMode::Shared,
-            AisMode::Warm,
+        for (mode, sharing) in [
+            (AisMode::Off, Sharing::TileOrder),
+            (AisMode::Aggressive, Sharing::TileOrder),
+            (AisMode::Shared, Sharing::TileOrder),
+            (AisMode::Warm, Sharing::TileOrder),
+            (AisMode::Shared, pass),
+            (AisMode::Warm, pass),
+            (AisMode::Guided, pass),
         ] {
             let gather = GatherSettings {
                 budget: RayBudget::Candidates,
+                sharing,
                 ..settings(strategy, mode, 16)
             };
             assert_agrees_with_the_reference(
@@ -408,7 +415,7 @@ fn every_mode_is_unbiased_with_a_fixed_candidate_budget() {
                 // Roulette without extra candidates gives rare large weights: the standard
                 // error needs more renders to be trustworthy (12 renders: a 7.9σ pixel).
                 64,
-                &format!("{strategy:?} {mode:?}, fixed candidates"),
+                &format!("{strategy:?} {mode:?} {sharing:?}, fixed candidates"),
             );
         }
     }

@@ -71,6 +71,24 @@ fn images_are_bit_identical_at_one_and_two_threads() {
         acceptance: ais_render::gather::Acceptance::SqrtAffinity,
         ..Default::default()
     });
+    // Maps from a learning pass around each tile: a tile's learning gathers at its edges
+    // are also computed by its neighbour tiles, on another thread, and must agree.
+    let from_a_pass = thread_independent(ais_render::gather::GatherSettings {
+        ais: ais_render::gather::AisMode::Shared,
+        sharing: ais_render::gather::Sharing::LearningPass { stride: 4 },
+        ..Default::default()
+    });
+    assert!(from_a_pass.ais.rejected_roulette > 0, "learned maps reject");
+    assert_ne!(
+        bits(&from_a_pass.image),
+        bits(&shared.image),
+        "a learning pass is another source of maps"
+    );
+    thread_independent(ais_render::gather::GatherSettings {
+        ais: ais_render::gather::AisMode::Warm,
+        sharing: ais_render::gather::Sharing::LearningPass { stride: 8 },
+        ..Default::default()
+    });
     // Guided gathers build their proposal from the same neighbourhood maps.
     let guided = thread_independent(ais_render::gather::GatherSettings {
         ais: ais_render::gather::AisMode::Guided,

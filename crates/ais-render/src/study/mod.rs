@@ -2,7 +2,8 @@
 //! reference at equal wall time and at equal traced rays, with several seeds, and a
 //! self-contained HTML report.
 //!
-//! Each run renders progressive passes of one sample per pixel until its budget is spent,
+//! Each run renders progressive passes (of one sample per pixel, or
+//! [`StudySettings::pass_spp`]) until its budget is spent,
 //! recording relMSE after every pass (the convergence curves). Equal-time runs stop at the
 //! time budget; equal-ray runs stop when they have traced as many rays (camera plus gather
 //! rays) as the baseline configuration traced in its equal-time runs (median over seeds).
@@ -115,6 +116,9 @@ pub struct StudySettings {
     pub seeds: u32,
     /// Samples per pixel of the reference (MIS, AIS off).
     pub reference_spp: u32,
+    /// Samples per pixel of each progressive pass (one render call): what a per-render cost,
+    /// such as the learning pass of shared maps, is spread over.
+    pub pass_spp: u32,
     /// Where the reference's two halves are cached (None: not cached).
     pub reference_cache: Option<[std::path::PathBuf; 2]>,
     /// The pixel of the affinity-map figure.
@@ -206,7 +210,7 @@ fn progressive(
     world: &World,
     settings: GatherSettings,
     reference: &reference::Reference,
-    seed: u64,
+    (seed, pass_spp): (u64, u32),
     budget: Budget,
 ) -> Run {
     let pixels = reference.image.pixels.len();
@@ -224,7 +228,7 @@ fn progressive(
         let output = render(
             world,
             &RenderSettings {
-                samples_per_pixel: 1,
+                samples_per_pixel: pass_spp,
                 integrator: Integrator::Gather(settings),
                 seed: mix64(seed ^ mix64(run.spp as u64 + 1)),
                 progress: false,
@@ -232,10 +236,10 @@ fn progressive(
         );
         for (s, p) in sum.iter_mut().zip(&output.image.pixels) {
             for c in 0..3 {
-                s[c] += p[c] as f64;
+                s[c] += p[c] as f64 * pass_spp as f64;
             }
         }
-        run.spp += 1;
+        run.spp += pass_spp;
         run.seconds += output.time.as_secs_f64();
         run.rays.merge(output.rays);
         run.stats.merge(&output.ais);
@@ -273,8 +277,10 @@ fn bar(progress: &MultiProgress, enabled: bool, template: &str) -> ProgressBar {
 
 /// Runs the study on `world` (its resolution as given).
 pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, String> {
-    if settings.configurations.is_empty() || settings.seeds == 0 {
-        return Err("a study needs at least one configuration and one seed".into());
+    if settings.configurations.is_empty() || settings.seeds == 0 || settings.pass_spp == 0 {
+        return Err(
+            "a study needs at least one configuration, one seed and one sample per pass".into(),
+        );
     }
     if settings.configurations[0].is_oracle() {
         return Err("the first configuration is the baseline and cannot be the oracle".into());
@@ -327,7 +333,7 @@ pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, Stri
                     world,
                     configuration.settings,
                     &reference,
-                    seed_of(s),
+                    (seed_of(s), settings.pass_spp),
                     budget,
                 ));
                 study_bar.inc(1);
@@ -356,7 +362,7 @@ pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, Stri
                 world,
                 result.configuration.settings,
                 &reference,
-                seed_of(s) ^ 0xe0,
+                (seed_of(s) ^ 0xe0, settings.pass_spp),
                 Budget::Rays(ray_budget),
             ));
             study_bar.inc(1);

@@ -86,7 +86,7 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
         context.seeds,
         results.reference.noise_floor()
     );
-    out.push_str("| configuration | spp | ms per pass | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio |\n|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| configuration | spp | ms per spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio |\n|---|---|---|---|---|---|---|---|---|\n");
     for row in rows.iter().filter(|r| !r.result.equal_time.is_empty()) {
         let runs = &row.result.equal_time;
         let spp = average(runs, |r| r.spp as f64);
