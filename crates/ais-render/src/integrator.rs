@@ -80,11 +80,7 @@ impl SampleContext {
     /// Bytes of AIS state this context holds: the batch's map and observations, the shared
     /// maps of the tile's recent gathers or of its learning pass, and the guides.
     pub fn ais_memory_bytes(&self) -> usize {
-        let batch = self.batch.as_ref().map_or(0, |b| {
-            b.map().map_or(0, ais::AffinityMap::memory_bytes)
-                + b.observations().map_or(0, ais::AffinityMap::memory_bytes)
-        });
-        batch
+        self.batch.as_ref().map_or(0, Batch::memory_bytes)
             + self.shared.memory_bytes()
             + self.learned.memory_bytes()
             + self

@@ -23,7 +23,7 @@ use crate::integrator::RayCounts;
 use crate::shared_maps::Neighbour;
 use crate::world::World;
 use ais::rng::{mix64, Pcg32};
-use ais::{AffinityMap, Batch, MapStart};
+use ais::{Batch, MapStart};
 
 /// Seeds of learning gathers are drawn from a domain apart from the pixels' seeds, so that a
 /// pixel's gather never reuses the random numbers its map was learned from.
@@ -135,15 +135,11 @@ impl LearningPass {
 
     /// Bytes held: the learned maps and the learning batch's own.
     pub fn memory_bytes(&self) -> usize {
-        let batch = self.batch.as_ref().map_or(0, |b| {
-            b.map().map_or(0, AffinityMap::memory_bytes)
-                + b.observations().map_or(0, AffinityMap::memory_bytes)
-        });
-        batch
+        self.batch.as_ref().map_or(0, Batch::memory_bytes)
             + self
                 .cells
                 .iter()
-                .map(|c| c.observations.memory_bytes() + std::mem::size_of::<Neighbour>())
+                .map(Neighbour::memory_bytes)
                 .sum::<usize>()
     }
 }

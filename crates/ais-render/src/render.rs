@@ -46,6 +46,19 @@ pub struct RenderOutput {
     pub ais_memory_per_thread: usize,
 }
 
+/// What one tile's render produced.
+struct TileResult {
+    tile: PixelRect,
+    /// Row-major, `tile`'s width per row.
+    pixels: Vec<[f32; 3]>,
+    /// Traced gather rays per camera sample, per pixel.
+    traced: Vec<f32>,
+    counts: RayCounts,
+    stats: ais::Stats,
+    ais_time: Duration,
+    ais_memory: usize,
+}
+
 /// The seed of pixel (x, y) of a `width`-wide image.
 pub fn pixel_seed(seed: u64, x: usize, y: usize, width: usize) -> u64 {
     mix64(seed ^ mix64((y * width + x) as u64))
@@ -74,16 +87,6 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
         ProgressBar::hidden()
     };
     let started = Instant::now();
-    type TileResult = (
-        usize,
-        usize,
-        Vec<[f32; 3]>,
-        Vec<f32>,
-        RayCounts,
-        ais::Stats,
-        Duration,
-        usize,
-    );
     let results: Vec<TileResult> = tiles
         .par_iter()
         .map(|&(x0, y0)| {
@@ -128,23 +131,19 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
                 }
             }
             progress.inc(1);
-            let stats = context
-                .batch
-                .as_ref()
-                .map(|b| *b.stats())
-                .unwrap_or_default();
-            let ais_time = context.ais_timer.estimate();
-            let memory = context.ais_memory_bytes();
-            (
-                x0,
-                y0,
+            TileResult {
+                tile,
+                stats: context
+                    .batch
+                    .as_ref()
+                    .map(|b| *b.stats())
+                    .unwrap_or_default(),
+                ais_time: context.ais_timer.estimate(),
+                ais_memory: context.ais_memory_bytes(),
+                counts: context.counts,
                 pixels,
                 traced,
-                context.counts,
-                stats,
-                ais_time,
-                memory,
-            )
+            }
         })
         .collect();
     progress.finish_and_clear();
@@ -154,14 +153,15 @@ pub fn render(world: &World, settings: &RenderSettings) -> RenderOutput {
     let mut traced_per_sample = vec![0.0; width * height];
     let mut ais_time = Duration::ZERO;
     let mut ais_memory_per_thread = 0;
-    for (x0, y0, pixels, traced, counts, stats, time, memory) in results {
-        ais_memory_per_thread = ais_memory_per_thread.max(memory);
-        rays.merge(counts);
-        ais_time += time;
-        ais_stats.merge(&stats);
-        let tile_width = (x0 + TILE_SIZE).min(width) - x0;
-        for (i, (value, traced)) in pixels.into_iter().zip(traced).enumerate() {
-            let (x, y) = (x0 + i % tile_width, y0 + i / tile_width);
+    for result in results {
+        ais_memory_per_thread = ais_memory_per_thread.max(result.ais_memory);
+        rays.merge(result.counts);
+        ais_time += result.ais_time;
+        ais_stats.merge(&result.stats);
+        let tile = result.tile;
+        let tile_width = tile.x1 - tile.x0;
+        for (i, (value, traced)) in result.pixels.into_iter().zip(result.traced).enumerate() {
+            let (x, y) = (tile.x0 + i % tile_width, tile.y0 + i / tile_width);
             film.add(x, y, value);
             traced_per_sample[y * width + x] = traced;
         }

@@ -37,6 +37,13 @@ pub(crate) struct Neighbour {
     pub observations: AffinityMap,
 }
 
+impl Neighbour {
+    /// Bytes held (its map's texels and itself).
+    pub fn memory_bytes(&self) -> usize {
+        self.observations.memory_bytes() + std::mem::size_of::<Neighbour>()
+    }
+}
+
 /// Sets `map` to the blend of the neighbours near `point` (shading normal `normal`) in
 /// each group of `sources`, a neighbour of a group with radius `r` weighing
 /// `exp(−d²/r²) · max(0, n·n')⁸`; returns how many weighed at least [`LEAST_WEIGHT`]. With
@@ -98,9 +105,6 @@ impl SharedMaps {
 
     /// Bytes held (the maps' texels).
     pub fn memory_bytes(&self) -> usize {
-        self.neighbours
-            .iter()
-            .map(|n| n.observations.memory_bytes() + std::mem::size_of::<Neighbour>())
-            .sum()
+        self.neighbours.iter().map(Neighbour::memory_bytes).sum()
     }
 }

@@ -349,6 +349,15 @@ impl<V: Value> Batch<V> {
         self.observations.as_ref()
     }
 
+    /// Bytes held by its maps (the affinity map and the observation map, when present).
+    pub fn memory_bytes(&self) -> usize {
+        self.map.as_ref().map_or(0, AffinityMap::memory_bytes)
+            + self
+                .observations
+                .as_ref()
+                .map_or(0, AffinityMap::memory_bytes)
+    }
+
     /// The configuration.
     pub fn config(&self) -> &BatchConfig {
         &self.config

@@ -90,34 +90,25 @@ fn assert_all_within(results: &[(String, f64)], bound: f64) {
     );
 }
 
+/// Frozen-map epochs (4) over the whole grid, within 4 standard errors.
+fn assert_epochs_unbiased(placement: Placement, stopping: Stopping) {
+    let results = measure_grid(Learning::Epochs { epochs: 4 }, placement, stopping);
+    assert_all_within(&results, 4.0);
+}
+
 #[test]
 fn epochs_with_random_placement_and_n_plus_one_are_unbiased() {
-    let results = measure_grid(
-        Learning::Epochs { epochs: 4 },
-        Placement::Random,
-        Stopping::DropLast,
-    );
-    assert_all_within(&results, 4.0);
+    assert_epochs_unbiased(Placement::Random, Stopping::DropLast);
 }
 
 #[test]
 fn epochs_with_halton_placement_and_candidate_budget_are_unbiased() {
-    let results = measure_grid(
-        Learning::Epochs { epochs: 4 },
-        Placement::Halton,
-        Stopping::CandidateBudget,
-    );
-    assert_all_within(&results, 4.0);
+    assert_epochs_unbiased(Placement::Halton, Stopping::CandidateBudget);
 }
 
 #[test]
 fn epochs_with_halton_placement_and_fixed_candidates_are_unbiased() {
-    let results = measure_grid(
-        Learning::Epochs { epochs: 4 },
-        Placement::Halton,
-        Stopping::FixedCandidates,
-    );
-    assert_all_within(&results, 4.0);
+    assert_epochs_unbiased(Placement::Halton, Stopping::FixedCandidates);
 }
 
 /// The talk's continuous updates are not exactly unbiased in theory (acceptance changes
