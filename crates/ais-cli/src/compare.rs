@@ -1,13 +1,10 @@
 //! `ais compare`: a study of gather configurations on one scene, with an HTML report.
 
-use crate::{
-    gather_settings, load_world, parse_ais, parse_define, parse_resolution, start_threads,
-    BatchArgs, GatherFlags,
-};
-use ais_render::gather::{AisMode, GatherSettings};
-use ais_render::proposal::Strategy;
-use ais_render::study::report::{self, ReportContext};
-use ais_render::study::{reference, talk_configurations, Configuration, StudySettings};
+use crate::gather_flags::{configuration, GatherFlags};
+use crate::{load_world, parse_define, parse_resolution, start_threads};
+use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Strategy};
+use ais_study::compare::report::{self, ReportContext};
+use ais_study::compare::{reference, talk_configurations, Configuration, StudySettings};
 use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::time::Duration;
@@ -25,20 +22,22 @@ pub struct CompareArgs {
     /// Independent runs per configuration and budget (for error bars).
     #[arg(long, default_value_t = 3)]
     seeds: u32,
-    /// Proposals to compare (uniform, bsdf, light, mis); with --ais, replaces the talk's set
-    /// of configurations by every strategy × AIS mode (and the oracle).
+    /// Proposals to compare (uniform, bsdf, light, mis); with --configs, replaces the talk's
+    /// set of configurations by every strategy × configuration (and the oracle).
     #[arg(long, value_delimiter = ',')]
     strategies: Vec<String>,
-    /// AIS modes to compare (off, aggressive, conservative, shared, warm, guided; +sqrt,
-    /// +value or +efficient for another acceptance rule, e.g. shared+efficient; @tile or
-    /// @pass[:S] for where shared maps come from, e.g. shared@pass:8); see --strategies.
+    /// Configurations to compare, each an AIS preset (off, aggressive, conservative, shared,
+    /// warm, guided) or gather parameters as name=value words applied over the base settings,
+    /// e.g. "ais=shared acceptance=efficient sharing=pass:8"; see --strategies. The first is
+    /// the baseline of the ratios.
     #[arg(long, value_delimiter = ',')]
-    ais: Vec<String>,
-    /// Leave out the oracle (with --ais; it traces every candidate, so it is slow).
+    configs: Vec<String>,
+    /// Leave out the oracle (with --configs; it traces every candidate, so it is slow).
     #[arg(long)]
     no_oracle: bool,
+    /// The base settings of every configuration (and of the reference's rays).
     #[command(flatten)]
-    batch: BatchArgs,
+    gather: GatherFlags,
     /// Film size (default: the scene's; 320x180 for the default scene).
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,
@@ -75,9 +74,21 @@ fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
     Ok((parse(x)?, parse(y)?))
 }
 
-/// The configurations: the talk's, or every given strategy × AIS mode plus the oracle.
+/// A configuration's settings: a preset's name, or name=value words.
+fn configuration_settings(base: &GatherSettings, text: &str) -> Result<GatherSettings, String> {
+    match Preset::parse(text.trim()) {
+        Some(preset) => Ok(base.with_preset(preset)),
+        None if text.contains('=') => configuration(base, text),
+        None => Err(format!(
+            "\"{text}\" is neither an AIS preset (off, aggressive, conservative, shared, warm, \
+             guided) nor name=value words"
+        )),
+    }
+}
+
+/// The configurations: the talk's, or every given strategy × configuration plus the oracle.
 fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Configuration>, String> {
-    if args.strategies.is_empty() && args.ais.is_empty() {
+    if args.strategies.is_empty() && args.configs.is_empty() {
         return Ok(talk_configurations(base));
     }
     let strategies = if args.strategies.is_empty() {
@@ -85,47 +96,33 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
     } else {
         args.strategies.clone()
     };
-    let modes = if args.ais.is_empty() {
+    let configs = if args.configs.is_empty() {
         vec!["off".to_string(), "aggressive".to_string()]
     } else {
-        args.ais.clone()
+        args.configs.clone()
     };
     let mut list = Vec::new();
     for strategy_name in &strategies {
         let strategy = Strategy::parse(strategy_name).ok_or_else(|| {
             format!("unknown strategy \"{strategy_name}\" (uniform, bsdf, light, mis)")
         })?;
-        for mode_name in &modes {
-            let (ais, acceptance, sharing) = parse_ais(mode_name)?;
-            if ais == AisMode::Oracle {
-                return Err("the oracle is always added; leave it out of --ais".into());
-            }
-            let name = format!("{strategy_name}-{mode_name}");
-            list.push(Configuration::new(
-                &name,
-                &name,
-                GatherSettings {
-                    strategy,
-                    ais,
-                    acceptance,
-                    sharing: sharing.unwrap_or(base.sharing),
-                    ..base
-                },
-            ));
+        for text in &configs {
+            let settings = configuration_settings(&GatherSettings { strategy, ..base }, text)?;
+            let name = format!("{strategy_name}-{}", text.trim().replace([' ', '='], "-"));
+            list.push(Configuration::new(&name, &name, settings));
         }
     }
     if args.no_oracle {
         return Ok(list);
     }
     let first = list[0].settings;
-    list.push(Configuration::new(
+    list.push(Configuration::oracle(
         &format!("{}-oracle", strategies[0]),
         "oracle: the first strategy restricted to directions that bring light",
         GatherSettings {
-            ais: AisMode::Oracle,
             placement: ais::Placement::Random,
-            acceptance: ais_render::gather::Acceptance::Affinity,
-            ..first
+            acceptance: Acceptance::Affinity,
+            ..first.with_preset(Preset::Off)
         },
     ));
     Ok(list)
@@ -145,11 +142,10 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
         args.resolution,
         (320, 180),
     )?;
-    let flags = GatherFlags {
-        batch: args.batch.clone(),
-        ..GatherFlags::default()
-    };
-    let base = gather_settings(&flags, world.description.integrator.as_ref())?;
+    let base = args.gather.settings(
+        &world.description.file,
+        world.description.integrator.as_ref(),
+    )?;
     let (width, height) = world.resolution;
     let pixel = args.pixel.unwrap_or((width / 2, height / 2));
     if pixel.0 >= width || pixel.1 >= height {
@@ -194,7 +190,7 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
             runs as f64 * args.seeds as f64 * args.time_budget
         );
     }
-    let results = ais_render::study::run(&world, &settings)?;
+    let results = ais_study::compare::run(&world, &settings)?;
     let scene_name = args
         .scene
         .as_ref()

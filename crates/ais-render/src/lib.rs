@@ -7,30 +7,21 @@
 
 #![warn(missing_docs)]
 
-pub mod ais_timer;
 pub mod atomic_write;
-pub mod benchmark;
 pub mod bsdf;
 pub mod camera;
 pub mod default_scene;
-pub mod distribution;
 pub mod error;
 pub mod film;
-pub mod gather;
 pub mod geometry;
-pub mod guiding;
 pub mod image_io;
-pub mod integrator;
-pub mod learning_pass;
+pub mod integrators;
 pub mod lights;
 pub mod mesh;
-pub mod oracle;
-pub mod proposal;
 pub mod render;
+pub mod sampling;
 pub mod scene;
 pub mod shapes;
-pub mod shared_maps;
-pub mod study;
 pub mod world;
 
 pub use error::InputError;

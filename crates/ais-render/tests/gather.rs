@@ -4,12 +4,13 @@
 
 mod common;
 
-use ais_render::gather::{Acceptance, AisMode, GatherSettings, RayBudget, Sharing};
-use ais_render::integrator::Integrator;
-use ais_render::proposal::Strategy;
-use ais_render::render::{render, RenderSettings};
+use ais_render::integrators::gather::{
+    Acceptance, GatherSettings, Preset, RayBudget, Sharing, Strategy,
+};
+use ais_render::integrators::Integrator;
 use ais_render::scene::load_scene;
 use ais_render::world::World;
+use common::{agreement, camera, occluded_scene, PixelStatistics};
 
 const STRATEGIES: [Strategy; 4] = [
     Strategy::Uniform,
@@ -17,106 +18,37 @@ const STRATEGIES: [Strategy; 4] = [
     Strategy::Light,
     Strategy::Mis,
 ];
-const MODES: [AisMode; 7] = [
-    AisMode::Off,
-    AisMode::Aggressive,
-    AisMode::Conservative,
-    AisMode::Shared,
-    AisMode::Warm,
-    AisMode::Guided,
-    AisMode::Oracle,
-];
+const MODES: [Preset; 6] = Preset::ALL;
 
-fn world(name: &str, xml: &str, files: &[(&str, &str)]) -> World {
-    let dir = common::scratch(name);
-    for (file, text) in files {
-        std::fs::write(dir.join(file), text).unwrap();
-    }
-    let path = dir.join("scene.xml");
-    std::fs::write(&path, xml).unwrap();
-    World::from_description(load_scene(&path, &[]).unwrap()).unwrap()
-}
-
-fn camera(origin: &str, target: &str, fov: f64, size: u32) -> String {
-    format!(
-        r#"<sensor type="perspective"><float name="fov" value="{fov}"/>
-        <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0, 0, 1"/></transform>
-        <film type="hdrfilm"><integer name="width" value="{size}"/><integer name="height" value="{size}"/></film></sensor>"#
-    )
-}
-
-/// Per-pixel mean and standard error over `renders` independent renders, and mean traced
-/// gather rays per camera sample.
+/// Statistics of the gather with `gather` settings.
 fn pixel_statistics(
     world: &World,
     gather: GatherSettings,
     spp: u32,
     renders: u64,
-) -> (Vec<f64>, Vec<f64>, f64) {
-    let count = world.resolution.0 as usize * world.resolution.1 as usize;
-    let (mut sum, mut sum_sq, mut traced) = (vec![0.0; count], vec![0.0; count], 0.0);
-    for seed in 0..renders {
-        let output = render(
-            world,
-            &RenderSettings {
-                samples_per_pixel: spp,
-                integrator: Integrator::Gather(gather),
-                seed: 1000 + seed,
-                progress: false,
-            },
-        );
-        for (i, p) in output.image.pixels.iter().enumerate() {
-            let v = p[0] as f64;
-            sum[i] += v;
-            sum_sq[i] += v * v;
-        }
-        traced += output
-            .traced_per_sample
-            .iter()
-            .map(|&t| t as f64)
-            .sum::<f64>()
-            / count as f64;
-    }
-    let r = renders as f64;
-    let mean: Vec<f64> = sum.iter().map(|s| s / r).collect();
-    let se = sum_sq
-        .iter()
-        .zip(&mean)
-        .map(|(s2, m)| ((s2 / r - m * m).max(0.0) * r / (r - 1.0) / r).sqrt())
-        .collect();
-    (mean, se, traced / r)
+) -> PixelStatistics {
+    common::pixel_statistics(world, &Integrator::Gather(gather), spp, renders)
 }
 
 /// The traced budget (the talk's reading: about `rays` traced per gather), which the
 /// equal-traced-ray comparisons here were written for; tests of the (default) candidate
 /// budget set it themselves.
-fn settings(strategy: Strategy, ais: AisMode, rays: u32) -> GatherSettings {
+fn settings(strategy: Strategy, ais: Preset, rays: u32) -> GatherSettings {
     GatherSettings {
         strategy,
-        ais,
         rays,
         budget: RayBudget::Traced,
-        ..GatherSettings::default()
+        ..GatherSettings::preset(ais)
     }
 }
 
 #[test]
 fn white_furnace() {
-    // A diffuse sphere of albedo 0.8 in a constant environment of radiance 1 reflects 0.8
-    // wherever it is seen; the camera sees only the sphere.
-    let xml = format!(
-        r#"<scene version="3.0.0">{}
-        <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
-        <shape type="sphere"><float name="radius" value="1"/>
-            <bsdf type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf></shape></scene>"#,
-        camera("0, -5, 0", "0, 0, 0", 8.0, 8)
-    );
-    let world = world("furnace", &xml, &[]);
+    let world = common::furnace();
     for strategy in STRATEGIES {
         for mode in MODES {
-            let (mean, se, _) = pixel_statistics(&world, settings(strategy, mode, 16), 2, 8);
-            let average = mean.iter().sum::<f64>() / mean.len() as f64;
-            let error = (se.iter().map(|s| s * s).sum::<f64>()).sqrt() / mean.len() as f64;
+            let statistics = pixel_statistics(&world, settings(strategy, mode, 16), 2, 8);
+            let (average, error) = statistics.image_mean();
             assert!(
                 (average - 0.8).abs() <= 4.0 * error + 1e-4,
                 "{strategy:?} {mode:?}: {average} ± {error}"
@@ -127,82 +59,43 @@ fn white_furnace() {
 
 #[test]
 fn plane_under_a_sphere_light_matches_the_analytic_irradiance() {
-    // Radiance L = 10, radius r = 0.5, centre 2 above a diffuse floor of albedo 0.5: directly
-    // below, the outgoing radiance is ρ L (r/d)² = 0.5 · 10 · 0.0625 = 0.3125.
-    let xml = format!(
-        r#"<scene version="3.0.0">{}
-        <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
-            <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
-        <shape type="sphere"><point name="center" x="0" y="0" z="2"/><float name="radius" value="0.5"/>
-            <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape></scene>"#,
-        camera("3, 0, 1", "0, 0, 0", 0.01, 1)
-    );
-    let world = world("sphere-light", &xml, &[]);
-    let exact = 0.3125;
+    let (world, exact) = common::plane_under_a_sphere_light();
     for strategy in STRATEGIES {
         for mode in MODES {
-            let (mean, se, _) = pixel_statistics(&world, settings(strategy, mode, 16), 16, 24);
-            let z = (mean[0] - exact) / se[0].max(1e-9);
+            let statistics = pixel_statistics(&world, settings(strategy, mode, 16), 16, 24);
+            let (mean, se) = (statistics.mean[0], statistics.se[0]);
+            let z = (mean - exact) / se.max(1e-9);
             assert!(
                 z.abs() < 4.0,
-                "{strategy:?} {mode:?}: {} ± {} (z {z:.1})",
-                mean[0],
-                se[0]
+                "{strategy:?} {mode:?}: {mean} ± {se} (z {z:.1})"
             );
         }
     }
-}
-
-/// A floor with a box on it under a sphere light, a rectangle light and a constant sky.
-fn occluded_scene() -> World {
-    let xml = format!(
-        r#"<scene version="3.0.0">{}
-        <emitter type="constant"><rgb name="radiance" value="0.3"/></emitter>
-        <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform></shape>
-        <shape type="cube"><transform name="to_world"><scale x="0.4" y="0.4" z="0.6"/><translate x="0.2" z="0.6"/></transform></shape>
-        <shape type="sphere"><point name="center" x="-1" y="0.5" z="1.5"/><float name="radius" value="0.3"/>
-            <emitter type="area"><rgb name="radiance" value="8"/></emitter></shape>
-        <shape type="rectangle"><transform name="to_world"><scale value="0.3"/><rotate x="1" angle="180"/><translate x="1" y="-0.5" z="1.6"/></transform>
-            <emitter type="area"><rgb name="radiance" value="6"/></emitter></shape></scene>"#,
-        camera("0, -3, 3", "0, 0, 0.2", 45.0, 6)
-    );
-    world("occluded", &xml, &[])
 }
 
 /// Asserts that `gather` agrees with the converged reference of the occluded scene pixel by
 /// pixel: no |z| above 4.5 and a mean z² below 2.
 fn assert_agrees_with_the_reference(
     world: &World,
-    (reference, reference_se): (&[f64], &[f64]),
+    reference: &PixelStatistics,
     gather: GatherSettings,
     renders: u64,
     what: &str,
 ) {
-    let (mean, se, _) = pixel_statistics(world, gather, 8, renders);
-    let z: Vec<f64> = mean
-        .iter()
-        .zip(&se)
-        .zip(reference.iter().zip(reference_se))
-        .map(|((m, s), (r, rs))| (m - r) / (s * s + rs * rs).sqrt().max(1e-9))
-        .collect();
-    let worst = z.iter().fold(0.0f64, |w, z| w.max(z.abs()));
-    let mean_square = z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64;
-    assert!(
-        worst < 4.5 && mean_square < 2.0,
-        "{what}: worst |z| {worst:.2}, mean z² {mean_square:.2}"
-    );
+    if let Err(message) = agreement(&pixel_statistics(world, gather, 8, renders), reference) {
+        panic!("{what}: {message}");
+    }
 }
 
 #[test]
 fn every_strategy_and_ais_mode_is_unbiased_against_a_reference() {
     let world = occluded_scene();
-    let (reference, reference_se, _) =
-        pixel_statistics(&world, settings(Strategy::Mis, AisMode::Off, 32), 64, 8);
+    let reference = pixel_statistics(&world, settings(Strategy::Mis, Preset::Off, 32), 64, 8);
     for strategy in STRATEGIES {
         for mode in MODES {
             assert_agrees_with_the_reference(
                 &world,
-                (&reference, &reference_se),
+                &reference,
                 settings(strategy, mode, 16),
                 12,
                 &format!("{strategy:?} {mode:?}"),
@@ -214,18 +107,17 @@ fn every_strategy_and_ais_mode_is_unbiased_against_a_reference() {
 #[test]
 fn every_acceptance_rule_is_unbiased_against_a_reference() {
     let world = occluded_scene();
-    let (reference, reference_se, _) =
-        pixel_statistics(&world, settings(Strategy::Mis, AisMode::Off, 32), 64, 8);
+    let reference = pixel_statistics(&world, settings(Strategy::Mis, Preset::Off, 32), 64, 8);
     let rules = [
         Acceptance::SqrtAffinity,
         Acceptance::ValueThreshold,
         Acceptance::ValueEfficient,
     ];
     for (mode, acceptance) in [
-        AisMode::Aggressive,
-        AisMode::Conservative,
-        AisMode::Shared,
-        AisMode::Warm,
+        Preset::Aggressive,
+        Preset::Conservative,
+        Preset::Shared,
+        Preset::Warm,
     ]
     .into_iter()
     .flat_map(|m| rules.map(|r| (m, r)))
@@ -236,7 +128,7 @@ fn every_acceptance_rule_is_unbiased_against_a_reference() {
         };
         assert_agrees_with_the_reference(
             &world,
-            (&reference, &reference_se),
+            &reference,
             gather,
             12,
             &format!("{mode:?} + {acceptance:?}"),
@@ -300,7 +192,7 @@ fn room(half_width: f64, bottom: f64, top: f64, ceiling: bool, target: &str) -> 
             1
         )
     );
-    world("interior", &xml, &[("room.obj", &obj)])
+    common::scene_world("interior", &xml, &[("room.obj", &obj)])
 }
 
 /// Floor points of the rooms, seen through a camera with a tiny field of view so that the
@@ -323,9 +215,10 @@ fn variance_gain(
             placement,
             ..settings(strategy, ais, rays)
         };
-        let (_, off_se, off_traced) = pixel_statistics(&world, with(AisMode::Off), 1, renders);
-        let (_, ais_se, ais_traced) =
-            pixel_statistics(&world, with(AisMode::Aggressive), 1, renders);
+        let off_run = pixel_statistics(&world, with(Preset::Off), 1, renders);
+        let (off_se, off_traced) = (off_run.se, off_run.traced);
+        let ais_run = pixel_statistics(&world, with(Preset::Aggressive), 1, renders);
+        let (ais_se, ais_traced) = (ais_run.se, ais_run.traced);
         off += off_se[0] * off_se[0] * off_traced;
         on += ais_se[0] * ais_se[0] * ais_traced;
     }
@@ -350,8 +243,8 @@ fn ais_lowers_variance_at_equal_traced_rays_in_an_occluded_interior() {
 /// Var · traced of one probe pixel rendered with `spp` gathers per render (so that shared
 /// maps have earlier gathers at the same point to learn from), over `renders` renders.
 fn variance_times_rays(world: &World, gather: GatherSettings, spp: u32, renders: u64) -> f64 {
-    let (_, se, traced) = pixel_statistics(world, gather, spp, renders);
-    se[0] * se[0] * traced
+    let statistics = pixel_statistics(world, gather, spp, renders);
+    statistics.se[0] * statistics.se[0] * statistics.traced
 }
 
 #[test]
@@ -369,9 +262,9 @@ fn shared_maps_beat_per_batch_ais_and_no_ais_at_equal_traced_rays() {
             map_height: 8,
             ..settings(Strategy::Mis, ais, 128)
         };
-        off += variance_times_rays(&world, with(AisMode::Off), 8, 150);
-        per_batch += variance_times_rays(&world, with(AisMode::Aggressive), 8, 150);
-        shared += variance_times_rays(&world, with(AisMode::Shared), 8, 150);
+        off += variance_times_rays(&world, with(Preset::Off), 8, 150);
+        per_batch += variance_times_rays(&world, with(Preset::Aggressive), 8, 150);
+        shared += variance_times_rays(&world, with(Preset::Shared), 8, 150);
     }
     println!(
         "Var · traced relative to AIS off: per-batch {:.2}, shared {:.2}",
@@ -388,20 +281,19 @@ fn shared_maps_beat_per_batch_ais_and_no_ais_at_equal_traced_rays() {
 #[test]
 fn every_mode_is_unbiased_with_a_fixed_candidate_budget() {
     let world = occluded_scene();
-    let (reference, reference_se, _) =
-        pixel_statistics(&world, settings(Strategy::Mis, AisMode::Off, 32), 64, 8);
+    let reference = pixel_statistics(&world, settings(Strategy::Mis, Preset::Off, 32), 64, 8);
     // The 6 × 6 image is one tile: a learning pass with 2-pixel blocks gives every pixel
     // learned neighbours all around.
     let pass = Sharing::LearningPass { stride: 2 };
     for strategy in [Strategy::Uniform, Strategy::Mis] {
         for (mode, sharing) in [
-            (AisMode::Off, Sharing::TileOrder),
-            (AisMode::Aggressive, Sharing::TileOrder),
-            (AisMode::Shared, Sharing::TileOrder),
-            (AisMode::Warm, Sharing::TileOrder),
-            (AisMode::Shared, pass),
-            (AisMode::Warm, pass),
-            (AisMode::Guided, pass),
+            (Preset::Off, Sharing::TileOrder),
+            (Preset::Aggressive, Sharing::TileOrder),
+            (Preset::Shared, Sharing::TileOrder),
+            (Preset::Warm, Sharing::TileOrder),
+            (Preset::Shared, pass),
+            (Preset::Warm, pass),
+            (Preset::Guided, pass),
         ] {
             let gather = GatherSettings {
                 budget: RayBudget::Candidates,
@@ -410,7 +302,7 @@ fn every_mode_is_unbiased_with_a_fixed_candidate_budget() {
             };
             assert_agrees_with_the_reference(
                 &world,
-                (&reference, &reference_se),
+                &reference,
                 gather,
                 // Roulette without extra candidates gives rare large weights: the standard
                 // error needs more renders to be trustworthy (12 renders: a 7.9σ pixel).
@@ -444,9 +336,9 @@ fn with_a_fixed_candidate_budget_shared_maps_cost_least_for_their_variance() {
         ..settings(Strategy::Mis, ais, 128)
     };
     let (spp, renders) = (2, 32);
-    let (off_mean, _, _) = pixel_statistics(&world, with(AisMode::Off), spp, renders);
+    let off_mean = pixel_statistics(&world, with(Preset::Off), spp, renders).mean;
     let cost = |gather: GatherSettings| {
-        let (_, se, traced) = pixel_statistics(&world, gather, spp, renders);
+        let PixelStatistics { se, traced, .. } = pixel_statistics(&world, gather, spp, renders);
         let relative: f64 = se
             .iter()
             .zip(&off_mean)
@@ -454,10 +346,10 @@ fn with_a_fixed_candidate_budget_shared_maps_cost_least_for_their_variance() {
             .sum();
         relative * (gather.rays as f64 + 2.0 * traced)
     };
-    let off = cost(with(AisMode::Off));
-    let per_batch = cost(with(AisMode::Aggressive)) / off;
-    let shared = cost(with(AisMode::Shared)) / off;
-    let warm = cost(with(AisMode::Warm)) / off;
+    let off = cost(with(Preset::Off));
+    let per_batch = cost(with(Preset::Aggressive)) / off;
+    let shared = cost(with(Preset::Shared)) / off;
+    let warm = cost(with(Preset::Warm)) / off;
     println!(
         "Var · cost relative to AIS off: per-batch {per_batch:.2}, shared {shared:.2}, warm {warm:.2}"
     );
@@ -541,13 +433,13 @@ fn measure_shared_maps_in_rooms() {
                         })
                         .sum::<f64>()
                 };
-                let off = measure(AisMode::Off, Acceptance::Affinity);
+                let off = measure(Preset::Off, Acceptance::Affinity);
                 let cells: Vec<String> = [
-                    (AisMode::Aggressive, Acceptance::Affinity),
-                    (AisMode::Aggressive, Acceptance::ValueEfficient),
-                    (AisMode::Shared, Acceptance::Affinity),
-                    (AisMode::Shared, Acceptance::ValueThreshold),
-                    (AisMode::Shared, Acceptance::ValueEfficient),
+                    (Preset::Aggressive, Acceptance::Affinity),
+                    (Preset::Aggressive, Acceptance::ValueEfficient),
+                    (Preset::Shared, Acceptance::Affinity),
+                    (Preset::Shared, Acceptance::ValueThreshold),
+                    (Preset::Shared, Acceptance::ValueEfficient),
                 ]
                 .iter()
                 .map(|&(ais, acceptance)| format!("{:.2}×", off / measure(ais, acceptance)))

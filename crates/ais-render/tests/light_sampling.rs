@@ -10,10 +10,10 @@ use ais::rng::Pcg32;
 use ais_render::bsdf::{Material, Microfacet, RoughPlastic, Scattering, ShadingFrame};
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
+use ais_render::integrators::gather::{GatherPoint, Strategy};
 use ais_render::lights::{
     AreaLight, AreaShape, Environment, EnvironmentGuide, EnvironmentMap, Lights, Rectangle,
 };
-use ais_render::proposal::{GatherPoint, Strategy};
 use base64::Engine;
 use glam::{DMat3, Vec3};
 use std::f32::consts::PI;

@@ -2,8 +2,10 @@
 //! model from npm (the Stanford bunny).
 
 use ais_render::default_scene::default_world;
-use ais_render::integrator::Integrator;
-use ais_render::render::{render, RenderSettings};
+use ais_render::integrators::gather::GatherStats;
+use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Sharing};
+use ais_render::integrators::{AmbientOcclusion, Integrator};
+use ais_render::render::{render, RenderOutput, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
 use std::path::{Path, PathBuf};
@@ -11,96 +13,88 @@ use std::path::{Path, PathBuf};
 mod common;
 use common::{npm_package, scratch};
 
-fn settings(integrator: Integrator, spp: u32) -> RenderSettings {
+fn settings(spp: u32) -> RenderSettings {
     RenderSettings {
         samples_per_pixel: spp,
-        integrator,
         seed: 5,
         progress: false,
     }
 }
 
+fn render_with(world: &World, integrator: Integrator, spp: u32) -> RenderOutput<GatherStats> {
+    render(world, &integrator, &settings(spp))
+}
+
 #[test]
 fn images_are_bit_identical_at_one_and_two_threads() {
-    // Both the gather (with AIS and its sampled timing) and ambient occlusion.
+    // Both the gather (with AIS) and ambient occlusion.
     let world = default_world(48, 27);
-    let ao = Integrator::AmbientOcclusion {
+    let ao = Integrator::AmbientOcclusion(AmbientOcclusion {
         rays: 4,
         distance: 1.0,
-    };
-    let gather = Integrator::Gather(ais_render::gather::GatherSettings {
-        ais: ais_render::gather::AisMode::Aggressive,
-        ..Default::default()
     });
-    let render_with = |threads: usize, integrator: Integrator| {
+    let gather = Integrator::Gather(GatherSettings::preset(Preset::Aggressive));
+    let on_threads = |threads: usize, integrator: Integrator| {
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| render(&world, &settings(integrator, 2)))
+            .install(|| render_with(&world, integrator, 2))
     };
     let bits = |image: &ais_render::image_io::RgbImage| -> Vec<u32> {
         image.pixels.iter().flatten().map(|c| c.to_bits()).collect()
     };
-    let lit_one = render_with(1, gather);
-    let lit_two = render_with(2, gather);
+    let lit_one = on_threads(1, gather);
+    let lit_two = on_threads(2, gather);
     assert_eq!(bits(&lit_one.image), bits(&lit_two.image));
-    assert_eq!(lit_one.ais, lit_two.ais);
-    assert!(
-        lit_one.ais_time.as_nanos() > 0,
-        "the AIS time estimate is measured"
-    );
+    assert_eq!(lit_one.stats.ais, lit_two.stats.ais);
     // Renders `settings` at 1 and 2 threads and checks that image and counts agree.
-    let thread_independent = |settings: ais_render::gather::GatherSettings| {
-        let one = render_with(1, Integrator::Gather(settings));
-        let two = render_with(2, Integrator::Gather(settings));
+    let thread_independent = |settings: GatherSettings| {
+        let one = on_threads(1, Integrator::Gather(settings));
+        let two = on_threads(2, Integrator::Gather(settings));
         assert_eq!(bits(&one.image), bits(&two.image), "{settings:?}");
-        assert_eq!(one.ais, two.ais, "{settings:?}");
+        assert_eq!(one.stats.ais, two.stats.ais, "{settings:?}");
         one
     };
     // Shared maps (with value-aware acceptance) learn across gathers in a fixed order.
-    let shared = thread_independent(ais_render::gather::GatherSettings {
-        ais: ais_render::gather::AisMode::Shared,
-        acceptance: ais_render::gather::Acceptance::ValueEfficient,
-        ..Default::default()
+    let shared = thread_independent(GatherSettings {
+        acceptance: Acceptance::ValueEfficient,
+        ..GatherSettings::preset(Preset::Shared)
     });
-    assert!(shared.ais.rejected_roulette > 0, "shared maps reject");
+    assert!(shared.stats.ais.rejected_roulette > 0, "shared maps reject");
     // Warm starts from the same maps, then per-batch learning, with √affinity acceptance.
-    thread_independent(ais_render::gather::GatherSettings {
-        ais: ais_render::gather::AisMode::Warm,
-        acceptance: ais_render::gather::Acceptance::SqrtAffinity,
-        ..Default::default()
+    thread_independent(GatherSettings {
+        acceptance: Acceptance::SqrtAffinity,
+        ..GatherSettings::preset(Preset::Warm)
     });
     // Maps from a learning pass around each tile: a tile's learning gathers at its edges
     // are also computed by its neighbour tiles, on another thread, and must agree.
-    let from_a_pass = thread_independent(ais_render::gather::GatherSettings {
-        ais: ais_render::gather::AisMode::Shared,
-        sharing: ais_render::gather::Sharing::LearningPass { stride: 4 },
-        ..Default::default()
+    let from_a_pass = thread_independent(GatherSettings {
+        sharing: Sharing::LearningPass { stride: 4 },
+        ..GatherSettings::preset(Preset::Shared)
     });
-    assert!(from_a_pass.ais.rejected_roulette > 0, "learned maps reject");
+    assert!(
+        from_a_pass.stats.ais.rejected_roulette > 0,
+        "learned maps reject"
+    );
     assert_ne!(
         bits(&from_a_pass.image),
         bits(&shared.image),
         "a learning pass is another source of maps"
     );
-    thread_independent(ais_render::gather::GatherSettings {
-        ais: ais_render::gather::AisMode::Warm,
-        sharing: ais_render::gather::Sharing::LearningPass { stride: 8 },
-        ..Default::default()
+    thread_independent(GatherSettings {
+        sharing: Sharing::LearningPass { stride: 8 },
+        ..GatherSettings::preset(Preset::Warm)
     });
     // Guided gathers build their proposal from the same neighbourhood maps.
-    let guided = thread_independent(ais_render::gather::GatherSettings {
-        ais: ais_render::gather::AisMode::Guided,
-        ..Default::default()
-    });
+    let guided = thread_independent(GatherSettings::preset(Preset::Guided));
     assert_ne!(
         bits(&guided.image),
         bits(&lit_one.image),
         "the guide changes the proposal"
     );
-    let one = render_with(1, ao);
-    let two = render_with(2, ao);
+    let one = on_threads(1, ao);
+    let two = on_threads(2, ao);
     assert_eq!(bits(&one.image), bits(&two.image));
     assert_eq!(one.rays, two.rays);
     // The image is not trivially uniform: the sculpture occludes.
@@ -143,7 +137,7 @@ fn an_xml_scene_with_an_obj_mesh_renders() {
     );
     let world = World::from_description(load_scene(&scene, &[]).unwrap()).unwrap();
     assert_eq!(world.geometry.triangle_count(), 2);
-    let output = render(&world, &settings(Integrator::Normals, 1));
+    let output = render_with(&world, Integrator::Normals, 1);
     // Centre pixel: the quad's normal +z maps to (0.5, 0.5, 1); a corner misses (black).
     let centre = output.image.pixels[16 * 32 + 16];
     assert!(
@@ -210,7 +204,7 @@ fn the_stanford_bunny_from_npm_loads_and_renders() {
     let world = World::from_description(load_scene(&scene, &[]).unwrap()).unwrap();
     // The npm bunny is the 1,839-vertex, 3,674-triangle low-resolution Stanford bunny.
     assert_eq!(world.geometry.triangle_count(), 3674);
-    let output = render(&world, &settings(Integrator::Normals, 1));
+    let output = render_with(&world, Integrator::Normals, 1);
     let covered = output
         .image
         .pixels

@@ -2,8 +2,8 @@
 
 mod common;
 
-use ais_render::gather::GatherSettings;
-use ais_render::integrator::Integrator;
+use ais_render::integrators::gather::GatherSettings;
+use ais_render::integrators::Integrator;
 use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
@@ -32,9 +32,9 @@ fn shipped_scenes_load_and_render() {
         assert!(world.lights.environment.is_some(), "{name} has a sky");
         let output = render(
             &world,
+            &Integrator::Gather(GatherSettings::default()),
             &RenderSettings {
                 samples_per_pixel: 1,
-                integrator: Integrator::Gather(GatherSettings::default()),
                 seed: 0,
                 progress: false,
             },

@@ -9,7 +9,8 @@ pub use conductors::named_conductor;
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
 pub use rough_plastic::RoughPlastic;
 
-use crate::geometry::{basis, cosine_hemisphere};
+use crate::geometry::basis;
+use crate::sampling::cosine_hemisphere;
 use crate::scene::{Plugin, Property};
 use glam::Vec3;
 use std::f32::consts::PI;

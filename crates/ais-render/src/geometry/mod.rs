@@ -4,12 +4,10 @@
 mod basis;
 mod primitive;
 mod ray;
-mod warp;
 
 pub use basis::basis;
 pub use primitive::{Primitive, Sphere, Triangle};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
-pub use warp::{cosine_hemisphere, uniform_sphere};
 
 use crate::mesh::TriangleMesh;
 use glam::{Vec2, Vec3, Vec3A};

@@ -3,8 +3,8 @@
 //! triangle). Emission is one-sided, toward the surface normal, as in Mitsuba.
 
 use super::spherical_rectangle::Rectangle;
-use crate::distribution::Distribution1D;
 use crate::geometry::{Ray, Sphere, Triangle};
+use crate::sampling::Distribution1D;
 use glam::Vec3;
 use std::f64::consts::PI;
 

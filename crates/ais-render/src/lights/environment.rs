@@ -11,9 +11,9 @@
 //! texel centres, each weighted by the mean luminance of its corners times its solid angle,
 //! so the density is positive wherever the interpolated radiance is.
 
-use crate::distribution::Distribution2D;
-use crate::geometry::uniform_sphere;
 use crate::image_io::RgbImage;
+use crate::sampling::uniform_sphere;
+use crate::sampling::Distribution2D;
 use glam::{DMat3, DVec3, Vec3};
 use std::f64::consts::PI;
 

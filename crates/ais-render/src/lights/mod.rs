@@ -11,8 +11,8 @@ pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
 pub use spherical_rectangle::Rectangle;
 
-use crate::distribution::Distribution1D;
 use crate::geometry::Ray;
+use crate::sampling::Distribution1D;
 use glam::Vec3;
 use std::f64::consts::PI;
 

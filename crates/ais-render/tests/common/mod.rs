@@ -72,3 +72,152 @@ pub fn shipped_scenes() -> Result<PathBuf, String> {
     }
     Ok(folder)
 }
+
+use ais_render::render::{render, RenderSettings, SampleIntegrator};
+use ais_render::scene::load_scene;
+use ais_render::world::World;
+
+/// A world from a scene text `xml` and side files `(name, text)`, written to a scratch
+/// folder `name`.
+pub fn scene_world(name: &str, xml: &str, files: &[(&str, &str)]) -> World {
+    let dir = scratch(name);
+    for (file, text) in files {
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, xml).unwrap();
+    World::from_description(load_scene(&path, &[]).unwrap()).unwrap()
+}
+
+/// A perspective sensor at `origin` looking at `target` (z up), square film of `size`.
+pub fn camera(origin: &str, target: &str, fov: f64, size: u32) -> String {
+    format!(
+        r#"<sensor type="perspective"><float name="fov" value="{fov}"/>
+        <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0, 0, 1"/></transform>
+        <film type="hdrfilm"><integer name="width" value="{size}"/><integer name="height" value="{size}"/></film></sensor>"#
+    )
+}
+
+/// A white furnace: a diffuse sphere of albedo 0.8 in a constant environment of radiance 1
+/// reflects 0.8 wherever it is seen; the camera sees only the sphere.
+pub fn furnace() -> World {
+    let xml = format!(
+        r#"<scene version="3.0.0">{}
+        <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+        <shape type="sphere"><float name="radius" value="1"/>
+            <bsdf type="diffuse"><rgb name="reflectance" value="0.8"/></bsdf></shape></scene>"#,
+        camera("0, -5, 0", "0, 0, 0", 8.0, 8)
+    );
+    scene_world("furnace", &xml, &[])
+}
+
+/// Radiance L = 10, radius r = 0.5, centre 2 above a diffuse floor of albedo 0.5, seen from
+/// one pixel: directly below, the outgoing radiance is ρ L (r/d)² = 0.5 · 10 · 0.0625.
+pub fn plane_under_a_sphere_light() -> (World, f64) {
+    let xml = format!(
+        r#"<scene version="3.0.0">{}
+        <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
+            <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+        <shape type="sphere"><point name="center" x="0" y="0" z="2"/><float name="radius" value="0.5"/>
+            <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape></scene>"#,
+        camera("3, 0, 1", "0, 0, 0", 0.01, 1)
+    );
+    (scene_world("sphere-light", &xml, &[]), 0.3125)
+}
+
+/// A floor with a box on it under a sphere light, a rectangle light and a constant sky.
+pub fn occluded_scene() -> World {
+    let xml = format!(
+        r#"<scene version="3.0.0">{}
+        <emitter type="constant"><rgb name="radiance" value="0.3"/></emitter>
+        <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform></shape>
+        <shape type="cube"><transform name="to_world"><scale x="0.4" y="0.4" z="0.6"/><translate x="0.2" z="0.6"/></transform></shape>
+        <shape type="sphere"><point name="center" x="-1" y="0.5" z="1.5"/><float name="radius" value="0.3"/>
+            <emitter type="area"><rgb name="radiance" value="8"/></emitter></shape>
+        <shape type="rectangle"><transform name="to_world"><scale value="0.3"/><rotate x="1" angle="180"/><translate x="1" y="-0.5" z="1.6"/></transform>
+            <emitter type="area"><rgb name="radiance" value="6"/></emitter></shape></scene>"#,
+        camera("0, -3, 3", "0, 0, 0.2", 45.0, 6)
+    );
+    scene_world("occluded", &xml, &[])
+}
+
+/// Per-pixel statistics of the red channel over independent renders.
+pub struct PixelStatistics {
+    /// Mean per pixel.
+    pub mean: Vec<f64>,
+    /// Standard error of the mean per pixel.
+    pub se: Vec<f64>,
+    /// Mean work per camera sample (for the gather: traced rays).
+    pub traced: f64,
+}
+
+impl PixelStatistics {
+    /// The image mean and its standard error.
+    pub fn image_mean(&self) -> (f64, f64) {
+        let n = self.mean.len() as f64;
+        let average = self.mean.iter().sum::<f64>() / n;
+        let error = self.se.iter().map(|s| s * s).sum::<f64>().sqrt() / n;
+        (average, error)
+    }
+}
+
+/// Per-pixel mean and standard error over `renders` independent renders of `spp` samples.
+pub fn pixel_statistics<I: SampleIntegrator>(
+    world: &World,
+    integrator: &I,
+    spp: u32,
+    renders: u64,
+) -> PixelStatistics {
+    let count = world.resolution.0 as usize * world.resolution.1 as usize;
+    let (mut sum, mut sum_sq, mut traced) = (vec![0.0; count], vec![0.0; count], 0.0);
+    for seed in 0..renders {
+        let settings = RenderSettings {
+            samples_per_pixel: spp,
+            seed: 1000 + seed,
+            progress: false,
+        };
+        let output = render(world, integrator, &settings);
+        for (i, p) in output.image.pixels.iter().enumerate() {
+            let v = p[0] as f64;
+            sum[i] += v;
+            sum_sq[i] += v * v;
+        }
+        traced += output
+            .work_per_sample
+            .iter()
+            .map(|&t| t as f64)
+            .sum::<f64>()
+            / count as f64;
+    }
+    let r = renders as f64;
+    let mean: Vec<f64> = sum.iter().map(|s| s / r).collect();
+    let se = sum_sq
+        .iter()
+        .zip(&mean)
+        .map(|(s2, m)| ((s2 / r - m * m).max(0.0) * r / (r - 1.0) / r).sqrt())
+        .collect();
+    PixelStatistics {
+        mean,
+        se,
+        traced: traced / r,
+    }
+}
+
+/// Whether `statistics` agrees with the converged `reference` pixel by pixel: no |z| above
+/// 4.5 and a mean z² below 2 (an error message otherwise).
+pub fn agreement(statistics: &PixelStatistics, reference: &PixelStatistics) -> Result<(), String> {
+    let z: Vec<f64> = statistics
+        .mean
+        .iter()
+        .zip(&statistics.se)
+        .zip(reference.mean.iter().zip(&reference.se))
+        .map(|((m, s), (r, rs))| (m - r) / (s * s + rs * rs).sqrt().max(1e-9))
+        .collect();
+    let worst = z.iter().fold(0.0f64, |w, z| w.max(z.abs()));
+    let mean_square = z.iter().map(|z| z * z).sum::<f64>() / z.len() as f64;
+    if worst < 4.5 && mean_square < 2.0 {
+        Ok(())
+    } else {
+        Err(format!("worst |z| {worst:.2}, mean z² {mean_square:.2}"))
+    }
+}

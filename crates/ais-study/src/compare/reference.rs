@@ -1,12 +1,11 @@
 //! The converged reference of a study, cached on disk by a hash of what determines it.
 
 use super::metrics::{rel_mse, RELMSE_EPSILON};
-use crate::gather::{AisMode, GatherSettings};
-use crate::image_io::{read_image, write_exr, RgbImage};
-use crate::integrator::Integrator;
-use crate::proposal::Strategy;
-use crate::render::{render, RenderSettings};
-use crate::world::World;
+use ais_render::image_io::{read_image, write_exr, RgbImage};
+use ais_render::integrators::gather::{GatherSettings, Preset, Strategy};
+use ais_render::integrators::Integrator;
+use ais_render::render::{render, RenderSettings};
+use ais_render::world::World;
 use indicatif::ProgressBar;
 use std::path::{Path, PathBuf};
 
@@ -80,9 +79,9 @@ fn render_half(
         let chunk = CHUNK.min(spp - done);
         let output = render(
             world,
+            &Integrator::Gather(settings),
             &RenderSettings {
                 samples_per_pixel: chunk,
-                integrator: Integrator::Gather(settings),
                 seed: seed + done as u64,
                 progress: false,
             },
@@ -126,8 +125,7 @@ pub fn reference(
     } else {
         let settings = GatherSettings {
             strategy: Strategy::Mis,
-            ais: AisMode::Off,
-            ..*gather
+            ..gather.with_preset(Preset::Off)
         };
         let half = spp.div_ceil(2);
         progress.set_length(2 * half as u64);

@@ -1,10 +1,12 @@
 //! The talk's affinity-map figure: one gather point's map after 0, 32 and 128 traced rays.
 
-use crate::ais_timer::AisTimer;
-use crate::gather::{gather_point, run_batch, AisMode, GatherSettings};
-use crate::integrator::RayCounts;
-use crate::world::World;
 use ais::{Batch, BatchConfig, Learning, Stopping};
+use ais_render::integrators::gather::guiding::CandidateSampler;
+use ais_render::integrators::gather::{
+    gather_point, run_batch, BatchProbe, BatchRun, GatherSettings, Preset,
+};
+use ais_render::render::RayCounts;
+use ais_render::world::World;
 
 /// Traced-ray counts at which the map is shown.
 pub const SNAPSHOTS: [u64; 3] = [0, 32, 128];
@@ -42,9 +44,8 @@ pub fn snapshots(
     }
     let at = gather_point(world, &hit, -ray.direction);
     let settings = GatherSettings {
-        ais: AisMode::Aggressive,
         rays: *SNAPSHOTS.last().expect("snapshots") as u32,
-        ..*settings
+        ..settings.with_preset(Preset::Aggressive)
     };
     let config = BatchConfig {
         learning: Learning::Continuous,
@@ -52,45 +53,49 @@ pub fn snapshots(
         ..settings.batch_config()
     };
     let mut batch = Batch::new(config).ok()?;
-    let snapshot = |batch: &Batch<[f32; 3]>| {
-        let map = batch.map().expect("an aggressive batch has a map");
-        let layout = map.level_layout(0);
-        MapSnapshot {
-            traced: batch.batch_stats().traced,
-            width: layout.width(),
-            height: layout.height(),
-            affinities: (0..layout.texel_count())
-                .map(|i| map.texel_affinity(0, layout.texel_of_index(i)))
-                .collect(),
-        }
-    };
-    let mut taken: Vec<MapSnapshot> = Vec::new();
-    let mut observe = |batch: &Batch<[f32; 3]>| {
-        let traced = batch.batch_stats().traced;
-        if SNAPSHOTS[1..].contains(&traced) && taken.iter().all(|s| s.traced != traced) {
-            taken.push(snapshot(batch));
-        }
-    };
-    let mut counts = RayCounts::default();
-    let mut timer = AisTimer::default();
+    let mut snapshots = Snapshots::default();
     // The empty map, before any ray.
     batch.begin(settings.rays, seed, ais::MapStart::Empty);
-    let mut all = vec![snapshot(&batch)];
-    run_batch(
+    snapshots.taken.push(snapshot(&batch));
+    let run = BatchRun {
         world,
-        &settings,
-        &at,
-        (
-            &mut batch,
-            &crate::guiding::Proposal::plain(settings.strategy),
-        ),
-        (seed, ais::MapStart::Empty),
-        &mut counts,
-        &mut timer,
-        &mut observe,
-    );
-    all.append(&mut taken);
-    Some(all)
+        settings: &settings,
+        at: &at,
+        sampler: &CandidateSampler::plain(settings.strategy),
+        seed,
+        start: ais::MapStart::Empty,
+    };
+    run_batch(&run, &mut batch, &mut RayCounts::default(), &mut snapshots);
+    Some(snapshots.taken)
+}
+
+/// A map's level-0 affinities now.
+fn snapshot(batch: &Batch<[f32; 3]>) -> MapSnapshot {
+    let map = batch.map().expect("an aggressive batch has a map");
+    let layout = map.level_layout(0);
+    MapSnapshot {
+        traced: batch.batch_stats().traced,
+        width: layout.width(),
+        height: layout.height(),
+        affinities: (0..layout.texel_count())
+            .map(|i| map.texel_affinity(0, layout.texel_of_index(i)))
+            .collect(),
+    }
+}
+
+/// Takes a snapshot whenever the batch has traced one of [`SNAPSHOTS`] rays.
+#[derive(Default)]
+struct Snapshots {
+    taken: Vec<MapSnapshot>,
+}
+
+impl BatchProbe for Snapshots {
+    fn recorded(&mut self, batch: &Batch<[f32; 3]>, _: [f32; 3], _: f32) {
+        let traced = batch.batch_stats().traced;
+        if SNAPSHOTS[1..].contains(&traced) && self.taken.iter().all(|s| s.traced != traced) {
+            self.taken.push(snapshot(batch));
+        }
+    }
 }
 
 /// An SVG of one snapshot: a `cell`-pixel square per texel, grey from black (affinity at

@@ -1,7 +1,7 @@
 //! Shared affinity maps: each gather starts from a fixed map blended from what the batches
 //! at neighbouring gather points traced before it.
 //!
-//! Every gather of `--ais shared` records its traced rays in an observation map
+//! Every gather with `map = neighbours` records its traced rays in an observation map
 //! ([`ais::Batch::observe_rays`]). A thread remembers the last [`NEIGHBOURS`] gathers of its
 //! current tile (point, normal, observations). The next gather blends them into its own
 //! map, each weighted by `exp(−d²/r²) · max(0, n·n')⁸` (distance `d`, normals `n`, `n'`,
@@ -13,8 +13,8 @@
 //! The memory is per thread, bounded by [`NEIGHBOURS`] maps, and starts empty at every tile,
 //! so what a gather sees depends only on the gathers before it in its tile, in the tile's
 //! fixed pixel order: the image is the same for any number of threads. With
-//! [`crate::gather::Sharing::LearningPass`] the maps of a learning pass around the tile
-//! ([`crate::learning_pass`]) are blended in as well.
+//! [`super::Sharing::LearningPass`] the maps of a learning pass around the tile
+//! ([`super::learning_pass`]) are blended in as well.
 
 use ais::AffinityMap;
 use glam::Vec3;
@@ -44,13 +44,22 @@ impl Neighbour {
     }
 }
 
+/// A group of neighbours and the radius of their weights.
+#[derive(Clone, Copy)]
+pub(crate) struct NeighbourSource<'a> {
+    /// The neighbours.
+    pub neighbours: &'a [Neighbour],
+    /// The radius r of their weights, in world units.
+    pub radius: f32,
+}
+
 /// Sets `map` to the blend of the neighbours near `point` (shading normal `normal`) in
 /// each group of `sources`, a neighbour of a group with radius `r` weighing
 /// `exp(−d²/r²) · max(0, n·n')⁸`; returns how many weighed at least [`LEAST_WEIGHT`]. With
 /// none, `map` is fresh (affinity 1).
 pub(crate) fn blend_neighbours(
     map: &mut AffinityMap,
-    sources: &[(&[Neighbour], f32)],
+    sources: &[NeighbourSource],
     point: Vec3,
     normal: Vec3,
 ) -> usize {
@@ -58,7 +67,7 @@ pub(crate) fn blend_neighbours(
     map.blend_from(
         sources
             .iter()
-            .flat_map(|&(neighbours, radius)| {
+            .flat_map(|&NeighbourSource { neighbours, radius }| {
                 let inverse_r2 = 1.0 / (radius * radius).max(f32::MIN_POSITIVE);
                 neighbours.iter().filter_map(move |neighbour| {
                     let facing = neighbour.normal.dot(normal).max(0.0);
@@ -74,12 +83,12 @@ pub(crate) fn blend_neighbours(
 
 /// The recent gathers of one thread's current tile.
 #[derive(Clone, Debug, Default)]
-pub struct SharedMaps {
+pub struct RecentGathers {
     neighbours: Vec<Neighbour>,
     next: usize,
 }
 
-impl SharedMaps {
+impl RecentGathers {
     /// The remembered gathers, oldest first or in any order (blending does not care).
     pub(crate) fn neighbours(&self) -> &[Neighbour] {
         &self.neighbours

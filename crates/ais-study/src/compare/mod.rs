@@ -15,19 +15,28 @@ pub mod plots;
 pub mod reference;
 pub mod report;
 
-use crate::gather::{AisMode, GatherSettings};
-use crate::image_io::RgbImage;
-use crate::integrator::{Integrator, RayCounts};
-use crate::proposal::Strategy;
-use crate::render::{render, RenderSettings};
-use crate::world::World;
+use crate::oracle::Oracle;
 use ais::rng::mix64;
+use ais_render::image_io::RgbImage;
+use ais_render::integrators::gather::{GatherSettings, Preset, Strategy};
+use ais_render::integrators::Integrator;
+use ais_render::render::{render, RayCounts, RenderSettings};
+use ais_render::world::World;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::Path;
 use std::time::Duration;
 
 /// Most passes of a run, whatever its budget.
 const MOST_PASSES: u32 = 1 << 14;
+
+/// What a configuration renders with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Technique {
+    /// The renderer's gather.
+    Gather,
+    /// The oracle with the gather's strategy and rays (a bound, run at equal rays only).
+    Oracle,
+}
 
 /// One configuration of the gather under study.
 #[derive(Clone, Debug, PartialEq)]
@@ -38,69 +47,124 @@ pub struct Configuration {
     pub label: String,
     /// The gather's settings.
     pub settings: GatherSettings,
+    /// The gather or the oracle.
+    pub technique: Technique,
 }
 
 impl Configuration {
-    /// A configuration named after its settings.
+    /// A gather configuration.
     pub fn new(name: &str, label: &str, settings: GatherSettings) -> Self {
         Configuration {
             name: name.into(),
             label: label.into(),
             settings,
+            technique: Technique::Gather,
+        }
+    }
+
+    /// The oracle with `settings`' strategy and rays.
+    pub fn oracle(name: &str, label: &str, settings: GatherSettings) -> Self {
+        Configuration {
+            technique: Technique::Oracle,
+            ..Configuration::new(name, label, settings)
         }
     }
 
     /// Whether this is the oracle (run at equal rays only).
     pub fn is_oracle(&self) -> bool {
-        self.settings.ais == AisMode::Oracle
+        self.technique == Technique::Oracle
     }
+
+    /// Renders one pass of `spp` samples per pixel with `seed`.
+    pub fn render_pass(&self, world: &World, spp: u32, seed: u64) -> Pass {
+        let settings = RenderSettings {
+            samples_per_pixel: spp,
+            seed,
+            progress: false,
+        };
+        match self.technique {
+            Technique::Gather => {
+                let output = render(world, &Integrator::Gather(self.settings), &settings);
+                Pass {
+                    image: output.image,
+                    seconds: output.time.as_secs_f64(),
+                    rays: output.rays,
+                    stats: output.stats.ais,
+                    ais_memory_per_thread: output.stats.memory_per_thread,
+                }
+            }
+            Technique::Oracle => {
+                let output = render(world, &Oracle(self.settings), &settings);
+                Pass {
+                    image: output.image,
+                    seconds: output.time.as_secs_f64(),
+                    rays: output.rays,
+                    stats: ais::Stats::default(),
+                    ais_memory_per_thread: 0,
+                }
+            }
+        }
+    }
+}
+
+/// What one rendered pass gives a study.
+pub struct Pass {
+    /// The image.
+    pub image: RgbImage,
+    /// Its render time.
+    pub seconds: f64,
+    /// Rays traced.
+    pub rays: RayCounts,
+    /// AIS statistics (zero for the oracle).
+    pub stats: ais::Stats,
+    /// The most AIS state one thread held (bytes).
+    pub ais_memory_per_thread: usize,
 }
 
 /// The talk's comparison on top of `base`: uniform, the importance sampler without and with
 /// AIS (aggressive, conservative), random against Halton placement, and the oracle.
 pub fn talk_configurations(base: GatherSettings) -> Vec<Configuration> {
-    let with = |strategy, ais, placement| GatherSettings {
+    let with = |strategy, preset, placement| GatherSettings {
         strategy,
-        ais,
         placement,
-        ..base
+        ..base.with_preset(preset)
     };
     use ais::Placement::{Halton, Random};
     vec![
         Configuration::new(
             "mis-off",
             "PHIS (MIS), AIS off",
-            with(Strategy::Mis, AisMode::Off, Halton),
+            with(Strategy::Mis, Preset::Off, Halton),
         ),
         Configuration::new(
             "uniform-off",
             "Uniform",
-            with(Strategy::Uniform, AisMode::Off, Halton),
+            with(Strategy::Uniform, Preset::Off, Halton),
         ),
         Configuration::new(
             "mis-aggressive",
             "PHIS + AIS aggressive",
-            with(Strategy::Mis, AisMode::Aggressive, Halton),
+            with(Strategy::Mis, Preset::Aggressive, Halton),
         ),
         Configuration::new(
             "mis-conservative",
             "PHIS + AIS conservative",
-            with(Strategy::Mis, AisMode::Conservative, Halton),
+            with(Strategy::Mis, Preset::Conservative, Halton),
         ),
         Configuration::new(
             "mis-off-random",
             "PHIS, random placement",
-            with(Strategy::Mis, AisMode::Off, Random),
+            with(Strategy::Mis, Preset::Off, Random),
         ),
         Configuration::new(
             "mis-aggressive-random",
             "PHIS + AIS aggressive, random placement",
-            with(Strategy::Mis, AisMode::Aggressive, Random),
+            with(Strategy::Mis, Preset::Aggressive, Random),
         ),
-        Configuration::new(
+        Configuration::oracle(
             "mis-oracle",
             "PHIS restricted to visible directions (oracle)",
-            with(Strategy::Mis, AisMode::Oracle, Random),
+            with(Strategy::Mis, Preset::Off, Random),
         ),
     ]
 }
@@ -208,7 +272,7 @@ enum Budget {
 
 fn progressive(
     world: &World,
-    settings: GatherSettings,
+    configuration: &Configuration,
     reference: &reference::Reference,
     (seed, pass_spp): (u64, u32),
     budget: Budget,
@@ -225,24 +289,17 @@ fn progressive(
         ais_memory_per_thread: 0,
     };
     loop {
-        let output = render(
-            world,
-            &RenderSettings {
-                samples_per_pixel: pass_spp,
-                integrator: Integrator::Gather(settings),
-                seed: mix64(seed ^ mix64(run.spp as u64 + 1)),
-                progress: false,
-            },
-        );
+        let output =
+            configuration.render_pass(world, pass_spp, mix64(seed ^ mix64(run.spp as u64 + 1)));
         for (s, p) in sum.iter_mut().zip(&output.image.pixels) {
             for c in 0..3 {
                 s[c] += p[c] as f64 * pass_spp as f64;
             }
         }
         run.spp += pass_spp;
-        run.seconds += output.time.as_secs_f64();
+        run.seconds += output.seconds;
         run.rays.merge(output.rays);
-        run.stats.merge(&output.ais);
+        run.stats.merge(&output.stats);
         run.ais_memory_per_thread = run.ais_memory_per_thread.max(output.ais_memory_per_thread);
         for (pixel, s) in run.image.pixels.iter_mut().zip(&sum) {
             *pixel = s.map(|v| (v / run.spp as f64) as f32);
@@ -331,7 +388,7 @@ pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, Stri
                 study_bar.set_message(format!("{} (equal time, seed {s})", configuration.name));
                 equal_time.push(progressive(
                     world,
-                    configuration.settings,
+                    configuration,
                     &reference,
                     (seed_of(s), settings.pass_spp),
                     budget,
@@ -360,7 +417,7 @@ pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, Stri
             ));
             result.equal_rays.push(progressive(
                 world,
-                result.configuration.settings,
+                &result.configuration,
                 &reference,
                 (seed_of(s) ^ 0xe0, settings.pass_spp),
                 Budget::Rays(ray_budget),
@@ -380,6 +437,6 @@ pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, Stri
 
 /// Writes `text` to `path` through a temporary file (an error names the path).
 pub fn write_text(path: &Path, text: &str) -> Result<(), String> {
-    crate::atomic_write::write_atomically(path, |temporary| std::fs::write(temporary, text))
+    ais_render::atomic_write::write_atomically(path, |temporary| std::fs::write(temporary, text))
         .map_err(|e: std::io::Error| format!("{}: cannot write: {e}", path.display()))
 }

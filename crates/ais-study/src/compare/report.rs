@@ -5,7 +5,7 @@ use super::affinity_figure::{snapshot_svg, SNAPSHOTS};
 use super::metrics::{relative_error_colours, rgbe};
 use super::plots::{log_log_svg, Series};
 use super::{mean_and_error, ConfigurationResult, Run, StudyResults};
-use crate::image_io::RgbImage;
+use ais_render::image_io::RgbImage;
 use base64::Engine;
 use std::fmt::Write;
 
@@ -393,7 +393,7 @@ pub fn write(
     std::fs::create_dir_all(&images)
         .map_err(|e| format!("{}: cannot create the folder: {e}", images.display()))?;
     let exr = |name: &str, image: &RgbImage| {
-        crate::image_io::write_exr(&images.join(format!("{name}.exr")), image)
+        ais_render::image_io::write_exr(&images.join(format!("{name}.exr")), image)
             .map_err(|e| e.to_string())
     };
     exr("reference", &results.reference.image)?;

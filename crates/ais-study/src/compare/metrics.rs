@@ -1,6 +1,6 @@
 //! Error metrics and image encodings for studies.
 
-use crate::image_io::RgbImage;
+use ais_render::image_io::RgbImage;
 
 /// The ε in relMSE's denominator: it keeps dark pixels from dominating.
 pub const RELMSE_EPSILON: f64 = 1e-2;

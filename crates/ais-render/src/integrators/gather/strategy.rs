@@ -2,8 +2,8 @@
 //! a direction and the density of the whole strategy at that direction.
 
 use crate::bsdf::{Material, ShadingFrame};
-use crate::geometry::uniform_sphere;
 use crate::lights::{EnvironmentGuide, Lights};
+use crate::sampling::uniform_sphere;
 use glam::Vec3;
 use std::f64::consts::PI;
 

@@ -1,8 +1,8 @@
 //! Guided gathers: the fixed map of a shared-map gather folded into the proposal instead of
 //! used for Russian roulette.
 //!
-//! `--ais guided` blends the same neighbourhood map as `--ais shared`
-//! ([`crate::shared_maps`]) and holds it fixed, but rather than drawing candidates from the
+//! `map_use = proposal` blends the same neighbourhood map as `map = neighbours`
+//! ([`super::neighbours`]) and holds it fixed, but rather than drawing candidates from the
 //! strategy's density `p` and skipping those the map thinks blocked, it changes what is drawn,
 //! so every in-support candidate is traced and weighs `f / q`: nothing is paid for rejected
 //! candidates and stratified placement stays stratified.
@@ -16,8 +16,8 @@
 //! Both keep a share of the unguided density everywhere, so the estimate is exactly
 //! unbiased whatever the map says, and a wrong map costs at most `1 / (1 − α)` in variance.
 
+use super::strategy::{GatherPoint, Strategy};
 use crate::lights::{Environment, EnvironmentGuide};
-use crate::proposal::{GatherPoint, Strategy};
 use ais::mapping::LatLong;
 use ais::{AffinityMap, TexelDistribution};
 use glam::Vec3;
@@ -28,19 +28,19 @@ pub const GUIDE_FRACTION: f32 = 0.5;
 /// The least affinity a guide gives any texel, so that no direction loses all density.
 pub const GUIDE_FLOOR: f32 = 1e-3;
 
-/// The proposal a gather draws candidates from: the strategy alone, or mixed with a guide.
+/// What a gather draws candidates from: the strategy alone, or mixed with a guide.
 #[derive(Clone, Copy)]
-pub struct Proposal<'a> {
+pub struct CandidateSampler<'a> {
     strategy: Strategy,
     guide: Option<&'a TexelDistribution>,
     /// The guide's share α.
     fraction: f32,
 }
 
-impl<'a> Proposal<'a> {
+impl<'a> CandidateSampler<'a> {
     /// The strategy alone.
     pub fn plain(strategy: Strategy) -> Self {
-        Proposal {
+        CandidateSampler {
             strategy,
             guide: None,
             fraction: 0.0,
@@ -51,7 +51,7 @@ impl<'a> Proposal<'a> {
     /// [0, 1); clamped so that the strategy always keeps a share and the estimate stays
     /// unbiased).
     pub fn guided(strategy: Strategy, guide: &'a TexelDistribution, fraction: f32) -> Self {
-        Proposal {
+        CandidateSampler {
             strategy,
             guide: Some(guide),
             fraction: fraction.clamp(0.0, 0.99),

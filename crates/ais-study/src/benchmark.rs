@@ -2,11 +2,11 @@
 //! for camera rays and for 256-ray gathers at the first hit, at several thread counts.
 //! Each figure is the median of several runs measured in one process.
 
-use crate::default_scene::default_world;
-use crate::geometry::{basis, cosine_hemisphere};
-use crate::geometry::{spawn_ray, Geometry};
-use crate::world::World;
 use ais::rng::Pcg32;
+use ais_render::default_scene::default_world;
+use ais_render::geometry::{basis, spawn_ray, Geometry};
+use ais_render::sampling::cosine_hemisphere;
+use ais_render::world::World;
 use rayon::prelude::*;
 use std::time::Instant;
 
@@ -29,7 +29,7 @@ fn median(mut values: Vec<f64>) -> f64 {
 }
 
 /// Camera rays of a `width × height` image, one per pixel centre.
-fn camera_rays(world: &World) -> Vec<crate::geometry::Ray> {
+fn camera_rays(world: &World) -> Vec<ais_render::geometry::Ray> {
     let (w, h) = world.resolution;
     (0..h)
         .flat_map(|y| (0..w).map(move |x| (x, y)))

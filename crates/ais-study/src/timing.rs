@@ -6,7 +6,14 @@
 //! in between, and that replay is timed as one region. The batch is deterministic, so the
 //! replay takes the same path; the image is not affected (the replay uses its own driver).
 
+use ais::rng::Pcg32;
 use ais::{Batch, BatchConfig, Decision, MapStart};
+use ais_render::geometry::Ray;
+use ais_render::integrators::gather::{
+    gather, BatchProbe, GatherSettings, GatherStats, GatherTile,
+};
+use ais_render::render::{RayCounts, SampleIntegrator, Tile, TileState, TileStats};
+use ais_render::world::World;
 use glam::Vec3;
 use std::time::{Duration, Instant};
 
@@ -33,9 +40,9 @@ pub struct AisTimer {
     spent: Duration,
 }
 
-impl AisTimer {
+impl BatchProbe for AisTimer {
     /// Marks the start of a gather; decides whether it is recorded for a timed replay.
-    pub fn start_gather(&mut self) {
+    fn started(&mut self) {
         self.recording = self.gathers.is_multiple_of(SAMPLING);
         self.gathers += 1;
         self.inputs.clear();
@@ -43,7 +50,7 @@ impl AisTimer {
 
     /// Notes the inputs of one `decide` call.
     #[inline]
-    pub fn decided(&mut self, direction: Vec3, in_support: bool) {
+    fn decided(&mut self, direction: Vec3, in_support: bool) {
         if self.recording {
             self.inputs.push(CandidateInput {
                 direction,
@@ -55,7 +62,7 @@ impl AisTimer {
 
     /// Notes the inputs of the `record` call that follows the last `decide`.
     #[inline]
-    pub fn recorded(&mut self, value: [f32; 3], rating: f32) {
+    fn recorded(&mut self, _: &Batch<[f32; 3]>, value: [f32; 3], rating: f32) {
         if self.recording {
             if let Some(last) = self.inputs.last_mut() {
                 last.recorded = Some((value, rating));
@@ -64,7 +71,7 @@ impl AisTimer {
     }
 
     /// Ends a gather: if it was recorded, replays its AIS calls and times them.
-    pub fn end_gather(&mut self, config: &BatchConfig, rays: u32, seed: u64) {
+    fn finished(&mut self, config: &BatchConfig, rays: u32, seed: u64) {
         if !self.recording {
             return;
         }
@@ -91,7 +98,9 @@ impl AisTimer {
         self.spent += start.elapsed();
         self.replayed += 1;
     }
+}
 
+impl AisTimer {
     /// Estimated time in AIS calls over all gathers so far.
     pub fn estimate(&self) -> Duration {
         if self.replayed == 0 {
@@ -99,5 +108,70 @@ impl AisTimer {
         }
         self.spent
             .mul_f64(self.gathers as f64 / self.replayed as f64)
+    }
+}
+
+/// The gather, with the time spent in the AIS library estimated by [`AisTimer`]. The image
+/// is the same as the plain gather's.
+#[derive(Clone, Copy, Debug)]
+pub struct TimedGather(pub GatherSettings);
+
+/// A timed gather's tile.
+pub struct TimedTile(GatherTile<AisTimer>);
+
+/// What a timed gather reports.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TimedStats {
+    /// The gather's own statistics.
+    pub gather: GatherStats,
+    /// Estimated time spent in AIS calls, summed over threads.
+    pub ais_time: Duration,
+}
+
+impl TileStats for TimedStats {
+    fn merge(&mut self, other: TimedStats) {
+        self.gather.merge(other.gather);
+        self.ais_time += other.ais_time;
+    }
+}
+
+impl TileState for TimedTile {
+    type Stats = TimedStats;
+
+    fn work(&self) -> u64 {
+        self.0.work()
+    }
+
+    fn finish(self) -> TimedStats {
+        let ais_time = self.0.probe.estimate();
+        TimedStats {
+            gather: self.0.finish(),
+            ais_time,
+        }
+    }
+}
+
+impl SampleIntegrator for TimedGather {
+    type Tile = TimedTile;
+
+    fn begin_tile(&self, world: &World, tile: &Tile, counts: &mut RayCounts) -> TimedTile {
+        TimedTile(GatherTile::begin(
+            world,
+            &self.0,
+            tile,
+            counts,
+            AisTimer::default(),
+        ))
+    }
+
+    fn radiance(
+        &self,
+        world: &World,
+        ray: &Ray,
+        rng: &mut Pcg32,
+        state: &mut TimedTile,
+        counts: &mut RayCounts,
+    ) -> [f32; 3] {
+        gather(world, &self.0, ray, rng, &mut state.0, counts).to_array()
     }
 }

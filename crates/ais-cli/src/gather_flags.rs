@@ -1,0 +1,139 @@
+//! The gather's command-line flags: the parameters of the scene's `<integrator
+//! type="gather">` (see `ais_render::integrators::gather::settings`), spelled with `-` for
+//! `_`. Flags override the scene's properties.
+
+use ais_render::integrators::gather::settings::PARAMETERS;
+use ais_render::integrators::gather::GatherSettings;
+use ais_render::scene::Plugin;
+use std::path::Path;
+
+/// The gather's parameters as flags (None: not given).
+#[derive(clap::Args, Clone, Default)]
+pub struct GatherFlags {
+    /// Gather proposal: uniform, bsdf, light or mis.
+    #[arg(long)]
+    strategy: Option<String>,
+    /// Candidates per gather, n.
+    #[arg(long)]
+    rays: Option<String>,
+    /// What --rays counts: candidates (AIS traces only the accepted ones) or traced (AIS draws
+    /// extra candidates to trace about n).
+    #[arg(long)]
+    budget: Option<String>,
+    /// Candidate placement: halton (scrambled per batch) or random.
+    #[arg(long)]
+    placement: Option<String>,
+    /// A preset of --map, --update and --map-use: off, aggressive, conservative (the talk's
+    /// per-batch maps), shared (fixed maps blended from neighbouring gathers), warm (that map
+    /// as a warm start, then per-batch learning) or guided (that map folded into the
+    /// proposal). The other flags apply after it.
+    #[arg(long)]
+    ais: Option<String>,
+    /// Where a batch's map starts: none (AIS off), batch (empty, learned from its own rays)
+    /// or neighbours (blended from neighbouring gathers, see --sharing).
+    #[arg(long)]
+    map: Option<String>,
+    /// How a batch learns from its own rays: off, aggressive or conservative.
+    #[arg(long)]
+    update: Option<String>,
+    /// How the map is used: roulette (skip probably blocked candidates) or proposal (fold the
+    /// map into the proposal; reject nothing).
+    #[arg(long)]
+    map_use: Option<String>,
+    /// Roulette's acceptance: affinity (the talk's), sqrt (√affinity), value (always trace
+    /// candidates worth over twice the batch's mean) or efficient (√affinity · value / mean).
+    #[arg(long)]
+    acceptance: Option<String>,
+    /// Where neighbours' maps come from: tile (the gathers before them in their tile) or pass
+    /// (a learning pass of AIS-off gathers around each tile, one per 4×4 pixels; pass:S for
+    /// S×S blocks, S in 1..=16).
+    #[arg(long)]
+    sharing: Option<String>,
+    /// Affinity-map tol (a_min = 1/(tol·h²)); "inf" for no floor.
+    #[arg(long)]
+    tol: Option<String>,
+    /// Affinity-map height in texels (width is twice this).
+    #[arg(long)]
+    map_res: Option<String>,
+    /// map-use proposal: the guide's share of the proposal mixture, in [0, 0.99].
+    #[arg(long)]
+    guide_fraction: Option<String>,
+}
+
+impl GatherFlags {
+    /// The flag of parameter `name`, if given.
+    fn get(&self, name: &str) -> Option<&str> {
+        let value = match name {
+            "strategy" => &self.strategy,
+            "rays" => &self.rays,
+            "budget" => &self.budget,
+            "placement" => &self.placement,
+            "ais" => &self.ais,
+            "map" => &self.map,
+            "update" => &self.update,
+            "map_use" => &self.map_use,
+            "acceptance" => &self.acceptance,
+            "sharing" => &self.sharing,
+            "tol" => &self.tol,
+            "map_res" => &self.map_res,
+            "guide_fraction" => &self.guide_fraction,
+            _ => &None,
+        };
+        value.as_deref()
+    }
+
+    /// Gather settings: defaults, then the scene's `<integrator type="gather">` properties
+    /// (`plugin`, read from `file`), then these flags.
+    pub fn settings(&self, file: &Path, plugin: Option<&Plugin>) -> Result<GatherSettings, String> {
+        let mut settings = match plugin.filter(|p| p.kind == "gather") {
+            Some(plugin) => GatherSettings::from_properties(plugin)
+                .map_err(|(line, message)| format!("{}:{line}: {message}", file.display()))?,
+            None => GatherSettings::default(),
+        };
+        self.apply(&mut settings)?;
+        Ok(settings)
+    }
+
+    /// Overrides `settings` with the flags given, and checks the result.
+    pub fn apply(&self, settings: &mut GatherSettings) -> Result<(), String> {
+        for name in PARAMETERS {
+            if let Some(value) = self.get(name) {
+                settings
+                    .set(name, value)
+                    .map_err(|message| format!("--{}: {message}", name.replace('_', "-")))?;
+            }
+        }
+        settings.validate()
+    }
+}
+
+/// Settings from a configuration text of `name=value` words (the gather's parameter names),
+/// applied in the parameter table's order on top of `base`: e.g. "ais=shared
+/// acceptance=efficient".
+pub fn configuration(base: &GatherSettings, text: &str) -> Result<GatherSettings, String> {
+    let mut given = Vec::new();
+    for word in text.split_whitespace() {
+        let (name, value) = word
+            .split_once('=')
+            .ok_or_else(|| format!("\"{word}\" in \"{text}\" is not name=value"))?;
+        if !PARAMETERS.contains(&name) {
+            return Err(format!(
+                "unknown gather parameter \"{name}\" in \"{text}\" (known: {})",
+                PARAMETERS.join(", ")
+            ));
+        }
+        given.push((name, value));
+    }
+    let mut settings = *base;
+    for name in PARAMETERS {
+        for (_, value) in given.iter().filter(|(n, _)| *n == name) {
+            settings
+                .set(name, value)
+                .map_err(|m| format!("\"{text}\": {m}"))?;
+        }
+    }
+    settings
+        .validate()
+        .map_err(|m| format!("\"{text}\": {m}"))?;
+    Ok(settings)
+}

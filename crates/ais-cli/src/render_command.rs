@@ -1,0 +1,323 @@
+//! `ais render`: render a scene (or the built-in default scene) to EXR and a PNG preview.
+
+use crate::gather_flags::GatherFlags;
+use crate::{load_world, parse_define, parse_resolution, start_threads};
+use ais_render::image_io::{write_exr, write_png, RgbImage};
+use ais_render::integrators::gather::GatherStats;
+use ais_render::integrators::{AmbientOcclusion, Integrator};
+use ais_render::render::{render, RenderOutput, RenderSettings};
+use ais_render::world::World;
+use ais_study::oracle::Oracle;
+use ais_study::timing::{TimedGather, SAMPLING};
+use clap::ValueEnum;
+use std::io::IsTerminal;
+use std::path::PathBuf;
+use std::time::Duration;
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum IntegratorChoice {
+    /// Direct light gathered with `--rays` rays per camera sample through the AIS driver.
+    Gather,
+    /// Ambient occlusion (cosine-weighted, bounded distance).
+    Ao,
+    /// Shading normals as colours.
+    Normals,
+}
+
+#[derive(clap::Args)]
+pub struct RenderArgs {
+    /// The scene file (Mitsuba 3 XML). Omit it to render the built-in default scene.
+    scene: Option<PathBuf>,
+    /// Output EXR (32-bit float RGB); a tone-mapped PNG preview is written beside it.
+    #[arg(short, long, default_value = "ais.exr")]
+    output: PathBuf,
+    /// Samples per pixel (default: the scene's sample_count; 4 for the default scene).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Override the film size, e.g. 640x360.
+    #[arg(long, value_parser = parse_resolution)]
+    resolution: Option<(u32, u32)>,
+    /// What to render (default: the scene's `<integrator type="gather">`, else gather).
+    #[arg(long, value_enum)]
+    integrator: Option<IntegratorChoice>,
+    #[command(flatten)]
+    gather: GatherFlags,
+    /// Render the oracle instead of the gather: a bound for studies, the proposal restricted
+    /// to directions that bring light, found by free brute-force visibility tests.
+    #[arg(long)]
+    oracle: bool,
+    /// Estimate the time spent in the AIS library (1 in 16 gathers replayed and timed).
+    #[arg(long)]
+    time_ais: bool,
+    /// Also write the mean traced gather rays per camera sample, per pixel, to this EXR.
+    #[arg(long)]
+    aov_traced: Option<PathBuf>,
+    /// Ambient-occlusion rays per camera sample.
+    #[arg(long, default_value_t = 16)]
+    ao_rays: u32,
+    /// Ambient-occlusion distance in world units.
+    #[arg(long, default_value_t = 1.0)]
+    ao_distance: f32,
+    /// Exposure of the PNG preview, in stops.
+    #[arg(long, default_value_t = 0.0)]
+    exposure: f32,
+    /// Base random seed.
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    /// Skip the PNG preview.
+    #[arg(long)]
+    no_preview: bool,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+    /// Set a scene $parameter: -D name=value (repeatable).
+    #[arg(short = 'D', value_parser = parse_define)]
+    define: Vec<(String, String)>,
+}
+
+/// What a render produced, whatever integrator made it.
+struct Rendered {
+    output: RenderOutput<GatherStats>,
+    ais_time: Option<Duration>,
+}
+
+/// The integrator: the flag, else the scene's, else the gather.
+fn integrator_choice(args: &RenderArgs, world: &World) -> Result<IntegratorChoice, String> {
+    let file = world.description.file.display();
+    Ok(match (args.integrator, &world.description.integrator) {
+        (Some(choice), _) => choice,
+        (None, Some(plugin)) if plugin.kind == "gather" => IntegratorChoice::Gather,
+        (None, Some(plugin)) if plugin.kind == "direct" || plugin.kind == "path" => {
+            eprintln!(
+                "warning: {file}:{}: integrator \"{}\" rendered with ais's gather (MIS, direct light only)",
+                plugin.line, plugin.kind
+            );
+            IntegratorChoice::Gather
+        }
+        (None, Some(plugin)) => {
+            return Err(format!(
+                "{file}:{}: integrator \"{}\" is not supported (gather, direct)",
+                plugin.line, plugin.kind
+            ))
+        }
+        (None, None) => IntegratorChoice::Gather,
+    })
+}
+
+fn integrator(args: &RenderArgs, world: &World) -> Result<Integrator, String> {
+    Ok(match integrator_choice(args, world)? {
+        IntegratorChoice::Gather => {
+            let plugin = world.description.integrator.as_ref();
+            Integrator::Gather(args.gather.settings(&world.description.file, plugin)?)
+        }
+        IntegratorChoice::Normals => Integrator::Normals,
+        IntegratorChoice::Ao => {
+            if args.ao_rays == 0 || args.ao_distance.is_nan() || args.ao_distance <= 0.0 {
+                return Err("--ao-rays must be at least 1 and --ao-distance positive".into());
+            }
+            Integrator::AmbientOcclusion(AmbientOcclusion {
+                rays: args.ao_rays,
+                distance: args.ao_distance,
+            })
+        }
+    })
+}
+
+/// Renders with the integrator, its timed variant, or the oracle.
+fn run_integrator(
+    args: &RenderArgs,
+    world: &World,
+    integrator: &Integrator,
+    settings: &RenderSettings,
+) -> Result<Rendered, String> {
+    let gather = match integrator {
+        Integrator::Gather(gather) => Some(*gather),
+        _ => None,
+    };
+    match (gather, args.oracle, args.time_ais) {
+        (None, true, _) | (None, _, true) => {
+            Err("--oracle and --time-ais need the gather integrator".into())
+        }
+        (Some(_), true, true) => Err("the oracle is not timed: leave out --time-ais".into()),
+        (Some(gather), true, false) => {
+            let output = render(world, &Oracle(gather), settings);
+            Ok(Rendered {
+                output: RenderOutput {
+                    image: output.image,
+                    rays: output.rays,
+                    stats: GatherStats::default(),
+                    work_per_sample: output.work_per_sample,
+                    time: output.time,
+                },
+                ais_time: None,
+            })
+        }
+        (Some(gather), false, true) => {
+            let output = render(world, &TimedGather(gather), settings);
+            Ok(Rendered {
+                ais_time: Some(output.stats.ais_time),
+                output: RenderOutput {
+                    image: output.image,
+                    rays: output.rays,
+                    stats: output.stats.gather,
+                    work_per_sample: output.work_per_sample,
+                    time: output.time,
+                },
+            })
+        }
+        (_, false, false) => Ok(Rendered {
+            output: render(world, integrator, settings),
+            ais_time: None,
+        }),
+    }
+}
+
+/// Writes the image, the AOV and the preview.
+fn write_outputs(
+    args: &RenderArgs,
+    world: &World,
+    output: &RenderOutput<GatherStats>,
+) -> Result<(), String> {
+    write_exr(&args.output, &output.image).map_err(|e| e.to_string())?;
+    if let Some(path) = &args.aov_traced {
+        let (width, height) = world.resolution;
+        let aov = RgbImage {
+            width: width as usize,
+            height: height as usize,
+            pixels: output.work_per_sample.iter().map(|&t| [t; 3]).collect(),
+        };
+        write_exr(path, &aov).map_err(|e| e.to_string())?;
+    }
+    if !args.no_preview {
+        let preview = args.output.with_extension("png");
+        write_png(&preview, &output.image, args.exposure).map_err(|e| e.to_string())?;
+    }
+    Ok(())
+}
+
+/// `ais render`.
+pub fn run(args: RenderArgs) -> Result<(), String> {
+    start_threads(args.threads)?;
+    let extension = args
+        .output
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    if extension.as_deref() != Some("exr") {
+        return Err(format!(
+            "{}: the output must be an .exr file",
+            args.output.display()
+        ));
+    }
+    let world = load_world(
+        args.scene.as_deref(),
+        &args.define,
+        args.resolution,
+        (640, 360),
+    )?;
+    let integrator = integrator(&args, &world)?;
+    let samples_per_pixel = args.spp.unwrap_or(world.sample_count);
+    if samples_per_pixel == 0 {
+        return Err("--spp must be at least 1".into());
+    }
+    let settings = RenderSettings {
+        samples_per_pixel,
+        seed: args.seed,
+        progress: !args.quiet && std::io::stderr().is_terminal(),
+    };
+    let rendered = run_integrator(&args, &world, &integrator, &settings)?;
+    write_outputs(&args, &world, &rendered.output)?;
+    print_summary(&args, &world, &integrator, &rendered, samples_per_pixel);
+    Ok(())
+}
+
+fn print_summary(
+    args: &RenderArgs,
+    world: &World,
+    integrator: &Integrator,
+    rendered: &Rendered,
+    samples_per_pixel: u32,
+) {
+    let output = &rendered.output;
+    let (width, height) = world.resolution;
+    let seconds = output.time.as_secs_f64();
+    println!("scene        {}", world.description.file.display());
+    println!(
+        "resolution   {width}×{height}, {samples_per_pixel} spp, {} threads",
+        rayon::current_num_threads()
+    );
+    println!(
+        "triangles    {} ({} primitives)",
+        world.geometry.triangle_count(),
+        world.geometry.primitive_count()
+    );
+    println!(
+        "BVH build    {:.3} s",
+        world.geometry.build_time().as_secs_f64()
+    );
+    println!("render time  {seconds:.3} s");
+    println!(
+        "rays         {} camera + {} occlusion = {:.2} M rays/s",
+        output.rays.closest_hit,
+        output.rays.occlusion,
+        output.rays.total() as f64 / seconds.max(1e-9) / 1e6
+    );
+    if let Integrator::Gather(settings) = integrator {
+        print_gather_summary(args, settings, rendered, seconds);
+    }
+    println!("wrote        {}", args.output.display());
+    if !args.no_preview {
+        println!(
+            "preview      {}",
+            args.output.with_extension("png").display()
+        );
+    }
+}
+
+fn print_gather_summary(
+    args: &RenderArgs,
+    settings: &ais_render::integrators::gather::GatherSettings,
+    rendered: &Rendered,
+    seconds: f64,
+) {
+    if args.oracle {
+        println!(
+            "gather       oracle ({} strategy, n = {}): visibility tested for free",
+            settings.strategy.name(),
+            settings.rays
+        );
+        return;
+    }
+    let stats = rendered.output.stats.ais;
+    let gathers = stats.batches.max(1) as f64;
+    println!(
+        "gather       {} strategy, AIS {}, n = {}",
+        settings.strategy.name(),
+        settings.ais_label(),
+        settings.rays
+    );
+    println!(
+        "candidates   {} ({:.1} per gather): traced {:.1}, rejected outside support {:.1}, by roulette {:.1} per gather; {} resets",
+        stats.candidates,
+        stats.candidates as f64 / gathers,
+        stats.traced as f64 / gathers,
+        stats.rejected_outside_support as f64 / gathers,
+        stats.rejected_roulette as f64 / gathers,
+        stats.resets
+    );
+    if let Some(ais_time) = rendered.ais_time {
+        let cpu = seconds * rayon::current_num_threads() as f64;
+        println!(
+            "AIS code     ≈ {:.3} s of {cpu:.3} thread-seconds ({:.1}%; 1 in {SAMPLING} gathers replayed and timed)",
+            ais_time.as_secs_f64(),
+            100.0 * ais_time.as_secs_f64() / cpu.max(1e-9),
+        );
+    }
+    println!(
+        "AIS memory   {:.1} KiB per thread (maps, shared maps, guides)",
+        rendered.output.stats.memory_per_thread as f64 / 1024.0
+    );
+}

@@ -1,0 +1,166 @@
+//! One batch of a gather: candidates from the proposal, decided by the library's batch
+//! driver, traced and recorded. The host loop of the `ais` library, written for this
+//! renderer.
+
+use super::guiding::CandidateSampler;
+use super::light::Leaving;
+use super::settings::{GatherSettings, MapUse};
+use super::strategy::GatherPoint;
+use crate::lights::luminance;
+use crate::render::RayCounts;
+use crate::world::World;
+use ais::{rating, Batch, BatchConfig, Decision, MapStart};
+use glam::Vec3;
+
+/// Watches the calls a batch makes into the library, for studies (timing them, taking
+/// snapshots of the map). The renderer itself uses `()`, which watches nothing and costs
+/// nothing.
+pub trait BatchProbe {
+    /// A batch begins.
+    fn started(&mut self) {}
+    /// A candidate toward `direction` was decided (`in_support`: inside the BSDF's support).
+    fn decided(&mut self, _direction: Vec3, _in_support: bool) {}
+    /// The last decided candidate was traced and recorded `value` and `rating` in `batch`.
+    fn recorded(&mut self, _batch: &Batch<[f32; 3]>, _value: [f32; 3], _rating: f32) {}
+    /// The batch (configured as `config`, begun with `rays` and `seed`) finished.
+    fn finished(&mut self, _config: &BatchConfig, _rays: u32, _seed: u64) {}
+}
+
+impl BatchProbe for () {}
+
+/// What one batch runs on.
+pub struct BatchRun<'a> {
+    /// The scene.
+    pub world: &'a World,
+    /// The gather's settings (n, acceptance, how the map is used).
+    pub settings: &'a GatherSettings,
+    /// Where the gather happens.
+    pub at: &'a GatherPoint<'a>,
+    /// Where candidates come from.
+    pub sampler: &'a CandidateSampler<'a>,
+    /// The batch's scrambling seed.
+    pub seed: u64,
+    /// Whether the batch keeps the map it holds or starts from an empty one.
+    pub start: MapStart,
+}
+
+/// The running mean of earlier candidates' unoccluded values (value-aware acceptance).
+#[derive(Default)]
+struct RunningMean {
+    sum: f32,
+    count: u32,
+}
+
+impl RunningMean {
+    /// The mean so far (None before the first value), then adds `value`.
+    fn mean_then_add(&mut self, value: f32) -> Option<f32> {
+        let mean = (self.count > 0).then(|| self.sum / self.count as f32);
+        self.sum += value;
+        self.count += 1;
+        mean
+    }
+}
+
+/// Runs one batch of `run.settings.rays` rays through `batch` (configured for those
+/// settings, or a variant of them) and returns its estimate of the reflected direct light.
+pub fn run_batch<P: BatchProbe>(
+    run: &BatchRun,
+    batch: &mut Batch<[f32; 3]>,
+    counts: &mut RayCounts,
+    probe: &mut P,
+) -> Vec3 {
+    let at = run.at;
+    probe.started();
+    batch.begin(run.settings.rays, run.seed, run.start);
+    let mut values = RunningMean::default();
+    while let Some(candidate) = batch.next_candidate() {
+        let Some(direction) = run.sampler.sample_direction(at, candidate.u) else {
+            probe.decided(at.frame.normal, false);
+            batch.decide(at.frame.normal, false);
+            continue;
+        };
+        let in_support = at.material.in_support(&at.frame, at.wo, direction);
+        probe.decided(direction, in_support);
+        let (decision, known) = decide(run, batch, &mut values, direction, in_support);
+        if let Decision::Trace { .. } = decision {
+            let (value, rating) = trace(run, direction, known, counts);
+            batch.record(value.to_array(), rating);
+            probe.recorded(batch, value.to_array(), rating);
+        }
+    }
+    let estimate = batch.finish();
+    probe.finished(batch.config(), run.settings.rays, run.seed);
+    Vec3::from(estimate.value)
+}
+
+/// What is known of a candidate before it is traced.
+struct Known {
+    /// The proposal's density.
+    density: f64,
+    /// Its leaving ray.
+    leaving: Leaving,
+}
+
+/// Asks the batch whether to trace the candidate toward `direction`. Value-aware rules need
+/// the density and the unoccluded radiance before deciding; they are returned so that a
+/// traced candidate does not compute them twice.
+fn decide(
+    run: &BatchRun,
+    batch: &mut Batch<[f32; 3]>,
+    values: &mut RunningMean,
+    direction: Vec3,
+    in_support: bool,
+) -> (Decision, Option<Known>) {
+    let (at, acceptance) = (run.at, run.settings.acceptance);
+    if acceptance.needs_value() && in_support {
+        let density = run.sampler.pdf(at, direction);
+        let leaving = Leaving::new(run.world, at, direction);
+        let value = if density > 0.0 {
+            luminance(at.material.eval(&at.frame, at.wo, direction) * leaving.unoccluded)
+                / density as f32
+        } else {
+            0.0
+        };
+        let mean = values.mean_then_add(value);
+        let decision = batch.decide_with(direction, in_support, |affinity| {
+            acceptance.probability(affinity, value, mean)
+        });
+        return (decision, Some(Known { density, leaving }));
+    }
+    let decision = if run.settings.map_use == MapUse::Proposal {
+        // The map is already in the proposal: trace every candidate.
+        batch.decide_with(direction, in_support, |_| 1.0)
+    } else {
+        batch.decide_with(direction, in_support, |affinity| {
+            acceptance.probability(affinity, 0.0, None)
+        })
+    };
+    (decision, None)
+}
+
+/// Traces an accepted candidate: its contribution f·L/p and its rating.
+fn trace(
+    run: &BatchRun,
+    direction: Vec3,
+    known: Option<Known>,
+    counts: &mut RayCounts,
+) -> (Vec3, f32) {
+    let at = run.at;
+    let Known {
+        density: pdf,
+        leaving,
+    } = known.unwrap_or_else(|| Known {
+        density: run.sampler.pdf(at, direction),
+        leaving: Leaving::new(run.world, at, direction),
+    });
+    // A zero density, possible only at a light's rim in f32, brings nothing.
+    if pdf <= 0.0 {
+        return (Vec3::ZERO, rating(0.0, 0.0));
+    }
+    let actual = leaving.trace(run.world, counts);
+    let value = at.material.eval(&at.frame, at.wo, direction) * actual / pdf as f32;
+    (
+        value,
+        rating(luminance(actual), luminance(leaving.unoccluded)),
+    )
+}

@@ -1,0 +1,60 @@
+//! Light arriving at a gather point along a candidate direction: what it would bring with
+//! nothing in the way, and what the occlusion ray lets through.
+
+use super::strategy::GatherPoint;
+use crate::geometry::{spawn_ray, Ray};
+use crate::render::RayCounts;
+use crate::world::World;
+use glam::Vec3;
+
+/// The ray leaving a gather point toward a candidate direction, before it is traced.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Leaving {
+    /// The ray, offset from the surface.
+    ray: Ray,
+    /// The radiance it would bring if nothing blocked it.
+    pub unoccluded: Vec3,
+    /// How far it must be free (infinite toward the environment).
+    distance: f32,
+}
+
+impl Leaving {
+    /// The ray leaving `at` toward `direction`.
+    pub fn new(world: &World, at: &GatherPoint, direction: Vec3) -> Self {
+        let ray = spawn_ray(at.point, at.frame.geometric, direction);
+        let (unoccluded, distance) = world.lights.unoccluded(&ray);
+        Leaving {
+            ray,
+            unoccluded,
+            distance,
+        }
+    }
+
+    /// What the ray actually brings: its unoccluded radiance, or zero if blocked. Only rays
+    /// that could bring light are traced (and counted).
+    pub fn trace(self, world: &World, counts: &mut RayCounts) -> Vec3 {
+        // A ray whose unoccluded radiance is zero brings zero whatever blocks it.
+        if self.unoccluded == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        let mut ray = self.ray;
+        // The emitter's own surface is in the BVH: stop just short of it.
+        ray.t_max = self.distance * (1.0 - 1e-4);
+        counts.occlusion += 1;
+        if world.geometry.occluded(&ray) {
+            Vec3::ZERO
+        } else {
+            self.unoccluded
+        }
+    }
+}
+
+/// Radiance arriving at the gather point from `direction`, occluders included.
+pub fn arriving_light(
+    world: &World,
+    at: &GatherPoint,
+    direction: Vec3,
+    counts: &mut RayCounts,
+) -> Vec3 {
+    Leaving::new(world, at, direction).trace(world, counts)
+}

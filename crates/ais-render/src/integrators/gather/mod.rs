@@ -1,0 +1,226 @@
+//! The multi-ray gather integrator: direct light at the first hit, gathered with `n` rays
+//! through the AIS batch driver from a proposal strategy.
+//!
+//! - [`settings`]: the parameter table (from the scene's XML, overridden by flags);
+//! - [`strategy`]: the proposal samplers (uniform, BSDF, light, MIS);
+//! - [`acceptance`]: roulette's acceptance rules;
+//! - [`batch_loop`]: one batch through the library's driver;
+//! - [`neighbours`] and [`learning_pass`]: maps shared between gathers;
+//! - [`guiding`]: a fixed map folded into the proposal.
+
+pub mod acceptance;
+pub mod batch_loop;
+pub mod guiding;
+pub mod learning_pass;
+mod light;
+pub mod neighbours;
+pub mod settings;
+pub mod strategy;
+
+pub use acceptance::Acceptance;
+pub use batch_loop::{run_batch, BatchProbe, BatchRun};
+pub use light::arriving_light;
+pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing, Update};
+pub use strategy::{GatherPoint, Strategy};
+
+use crate::bsdf::ShadingFrame;
+use crate::geometry::{Hit, Ray};
+use crate::render::{RayCounts, Tile, TileState, TileStats};
+use crate::world::World;
+use ais::rng::Pcg32;
+use ais::{Batch, MapStart};
+use glam::Vec3;
+use guiding::{CandidateSampler, Guidance, Guide};
+use learning_pass::LearningPass;
+use neighbours::{blend_neighbours, NeighbourSource, RecentGathers, RADIUS_PIXELS};
+
+/// What a render's gathers report: the batches' counters and the AIS memory a thread held.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GatherStats {
+    /// Counts of the AIS batches.
+    pub ais: ais::Stats,
+    /// The most AIS state (maps, shared maps, guides) any one tile held, in bytes: what a
+    /// thread needs on top of the scene.
+    pub memory_per_thread: usize,
+}
+
+impl TileStats for GatherStats {
+    fn merge(&mut self, other: GatherStats) {
+        self.ais.merge(&other.ais);
+        self.memory_per_thread = self.memory_per_thread.max(other.memory_per_thread);
+    }
+}
+
+/// A tile's gather state: the reusable batch, the maps shared between its gathers, and a
+/// probe watching the batches (`()` in the renderer).
+#[derive(Default)]
+pub struct GatherTile<P: BatchProbe = ()> {
+    /// The batch driver (allocated on first use).
+    batch: Option<Batch<[f32; 3]>>,
+    /// The tile's recent gathers, for shared maps in tile order.
+    recent: RecentGathers,
+    /// The learning pass around this tile, for shared maps from a learning pass.
+    learned: LearningPass,
+    /// The guide distributions of `map_use = proposal` (allocated on first use).
+    guide: Option<Guide>,
+    /// What watches the batches.
+    pub probe: P,
+}
+
+impl<P: BatchProbe> GatherTile<P> {
+    /// The state for `tile`, watched by `probe`: runs the tile's learning pass if the
+    /// settings share maps from one (its rays are counted in `counts`).
+    pub fn begin(
+        world: &World,
+        settings: &GatherSettings,
+        tile: &Tile,
+        counts: &mut RayCounts,
+        probe: P,
+    ) -> Self {
+        let mut state = GatherTile {
+            batch: None,
+            recent: RecentGathers::default(),
+            learned: LearningPass::default(),
+            guide: None,
+            probe,
+        };
+        if let (true, Sharing::LearningPass { stride }) = (settings.shares_maps(), settings.sharing)
+        {
+            state
+                .learned
+                .learn(world, settings, stride as usize, tile, counts);
+        }
+        state
+    }
+
+    /// Bytes of AIS state held: the batch's map and observations, the shared maps of the
+    /// tile's recent gathers or of its learning pass, and the guides.
+    pub fn memory_bytes(&self) -> usize {
+        self.batch.as_ref().map_or(0, Batch::memory_bytes)
+            + self.recent.memory_bytes()
+            + self.learned.memory_bytes()
+            + self.guide.as_ref().map_or(0, Guide::memory_bytes)
+    }
+
+    /// The batches' counters so far.
+    pub fn ais_stats(&self) -> ais::Stats {
+        self.batch.as_ref().map(|b| *b.stats()).unwrap_or_default()
+    }
+}
+
+impl<P: BatchProbe> TileState for GatherTile<P> {
+    type Stats = GatherStats;
+
+    /// Traced gather rays.
+    fn work(&self) -> u64 {
+        self.batch.as_ref().map_or(0, |b| b.stats().traced)
+    }
+
+    fn finish(self) -> GatherStats {
+        GatherStats {
+            ais: self.ais_stats(),
+            memory_per_thread: self.memory_bytes(),
+        }
+    }
+}
+
+/// The gather point where `hit` is seen from direction `wo` (pointing away from it).
+pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a> {
+    let material = &world.materials[hit.shape as usize];
+    GatherPoint {
+        point: hit.point,
+        frame: ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo),
+        wo,
+        material,
+        lights: &world.lights,
+        environment_guide: None,
+    }
+}
+
+/// The gather: emitted radiance at the first hit of `ray` plus `n` rays of direct light
+/// through the AIS batch driver.
+pub fn gather<P: BatchProbe>(
+    world: &World,
+    settings: &GatherSettings,
+    ray: &Ray,
+    rng: &mut Pcg32,
+    state: &mut GatherTile<P>,
+    counts: &mut RayCounts,
+) -> Vec3 {
+    counts.closest_hit += 1;
+    let Some(hit) = world.geometry.intersect(ray) else {
+        return world.lights.background(ray.direction);
+    };
+    let emitted = world
+        .lights
+        .emitted(hit.shape, hit.geometric_normal, ray.direction);
+    if world.lights.is_empty() {
+        return emitted;
+    }
+    let mut at = gather_point(world, &hit, -ray.direction);
+    let sharing = settings.shares_maps();
+    let batch = state.batch.get_or_insert_with(|| {
+        let mut batch = Batch::new(settings.batch_config()).expect("valid gather configuration");
+        batch.observe_rays(sharing);
+        batch
+    });
+    let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+    let mut sampler = CandidateSampler::plain(settings.strategy);
+    let start = if sharing {
+        let map = batch.map_mut().expect("shared maps have a map");
+        let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
+        let recent = NeighbourSource {
+            neighbours: state.recent.neighbours(),
+            radius: RADIUS_PIXELS * footprint,
+        };
+        let (point, normal) = (hit.point, at.frame.normal);
+        let found = match settings.sharing {
+            Sharing::TileOrder => blend_neighbours(map, &[recent], point, normal),
+            // The pass gives neighbours on all sides; the tile's earlier gathers add theirs.
+            Sharing::LearningPass { stride } => {
+                let learned = NeighbourSource {
+                    neighbours: state.learned.neighbours(),
+                    radius: stride as f32 * footprint,
+                };
+                blend_neighbours(map, &[recent, learned], point, normal)
+            }
+        };
+        if settings.map_use == MapUse::Proposal && found > 0 {
+            let guide = state
+                .guide
+                .get_or_insert_with(|| Guide::new(settings.map_height));
+            match guide.prepare(map, settings.strategy, &at, settings.guide_fraction) {
+                Guidance::Unguided => {}
+                Guidance::Environment(environment) => at.environment_guide = Some(environment),
+                Guidance::Mixture(distribution) => {
+                    sampler = CandidateSampler::guided(
+                        settings.strategy,
+                        distribution,
+                        settings.guide_fraction,
+                    )
+                }
+            }
+        }
+        MapStart::Current
+    } else {
+        MapStart::Empty
+    };
+    let run = BatchRun {
+        world,
+        settings,
+        at: &at,
+        sampler: &sampler,
+        seed,
+        start,
+    };
+    let value = run_batch(&run, batch, counts, &mut state.probe);
+    if sharing {
+        let observations = batch
+            .observations()
+            .expect("shared maps observe their rays");
+        state
+            .recent
+            .remember(hit.point, at.frame.normal, observations);
+    }
+    emitted + value
+}

@@ -1,0 +1,519 @@
+//! The gather's settings: one parameter table, read from the scene's
+//! `<integrator type="gather">` and overridden by command-line flags of the same names.
+//!
+//! | name | type | default | what it sets |
+//! |---|---|---|---|
+//! | `strategy` | string | `mis` | the proposal: `uniform`, `bsdf`, `light` (or `emitter`), `mis` |
+//! | `rays` | integer | 16 | candidates per gather, n (1 to 1,048,576) |
+//! | `budget` | string | `candidates` | what `rays` counts: `candidates` (AIS traces only the accepted ones) or `traced` (AIS draws extra candidates to trace about n) |
+//! | `placement` | string | `halton` | candidate placement: `halton` (scrambled per batch) or `random` |
+//! | `ais` | string | `off` | a preset of the four map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided` |
+//! | `map` | string | `none` | where a batch's affinity map starts: `none` (AIS off), `batch` (empty, learned from the batch's own rays: the talk's), `neighbours` (blended from neighbouring gathers, see `sharing`) |
+//! | `update` | string | `off` | how the batch learns from its own rays, in frozen-map epochs: `off`, `aggressive`, `conservative` (the talk's shadow-edge resets) |
+//! | `map_use` | string | `roulette` | how the map is used: `roulette` (skip probably blocked candidates, weight 1/a) or `proposal` (fold the map into the proposal, reject nothing) |
+//! | `acceptance` | string | `affinity` | roulette's acceptance: `affinity` (the talk's), `sqrt`, `value`, `efficient` |
+//! | `sharing` | string | `tile` | where `neighbours` maps come from: `tile` (the gathers before it in its tile) or `pass` / `pass:S` (a learning pass over S×S pixel blocks, S in 1..=16; default 4) |
+//! | `tol` | float | 1 | the map's floor, a_min = 1/(tol·h²); `inf` for none |
+//! | `map_res` | integer | 4 | the map's height h in texels (width 2h), 1 to 1024 |
+//! | `guide_fraction` | float | 0.5 | `map_use = proposal`: the guide's share of the proposal, in [0, 0.99] |
+//!
+//! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
+//! `update`; `shared` = `map neighbours`; `warm` = `map neighbours, update aggressive`;
+//! `guided` = `map neighbours, map_use proposal`. A preset sets `map`, `update` and
+//! `map_use`; the other parameters keep their values, and any given alongside it apply after
+//! it.
+
+use super::acceptance::Acceptance;
+use super::strategy::Strategy;
+use crate::render::TILE_SIZE;
+use crate::scene::{Plugin, Property};
+use ais::{BatchConfig, MapConfig, Mode, Stopping};
+
+/// The parameter names, in the order they apply (a preset before the settings it bundles).
+pub const PARAMETERS: [&str; 13] = [
+    "strategy",
+    "rays",
+    "budget",
+    "placement",
+    "ais",
+    "map",
+    "update",
+    "map_use",
+    "acceptance",
+    "sharing",
+    "tol",
+    "map_res",
+    "guide_fraction",
+];
+
+/// Most rays (candidates) per gather.
+pub const MOST_RAYS: u32 = 1 << 20;
+/// Largest map height, in texels.
+pub const LARGEST_MAP_RES: u32 = 1024;
+
+/// Where a batch's affinity map starts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapSource {
+    /// No map: every in-support candidate is traced (AIS off).
+    None,
+    /// Empty, learned from the batch's own rays (the talk's per-batch maps).
+    Batch,
+    /// Blended from the rays of neighbouring gathers (see [`Sharing`]) and held fixed, so the
+    /// batch is exactly unbiased.
+    Neighbours,
+}
+
+/// How a batch learns from its own rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Update {
+    /// It does not: the map stays as it started.
+    Off,
+    /// The talk's aggressive update, in frozen-map epochs.
+    Aggressive,
+    /// The talk's conservative update (shadow-edge resets), in frozen-map epochs.
+    Conservative,
+}
+
+/// How the map steers the batch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MapUse {
+    /// Russian roulette: a candidate is traced with its acceptance probability and weighs
+    /// its inverse.
+    Roulette,
+    /// Folded into the proposal (see [`super::guiding`]): nothing is rejected.
+    Proposal,
+}
+
+/// A named bundle of [`MapSource`], [`Update`] and [`MapUse`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Preset {
+    /// No map.
+    Off,
+    /// The talk's per-batch aggressive map.
+    Aggressive,
+    /// The talk's per-batch conservative map.
+    Conservative,
+    /// Fixed maps blended from neighbouring gathers, used for roulette.
+    Shared,
+    /// That map as a warm start, then aggressive learning from the batch's rays.
+    Warm,
+    /// That map folded into the proposal.
+    Guided,
+}
+
+impl Preset {
+    /// Every preset.
+    pub const ALL: [Preset; 6] = [
+        Preset::Off,
+        Preset::Aggressive,
+        Preset::Conservative,
+        Preset::Shared,
+        Preset::Warm,
+        Preset::Guided,
+    ];
+
+    /// Its name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Preset::Off => "off",
+            Preset::Aggressive => "aggressive",
+            Preset::Conservative => "conservative",
+            Preset::Shared => "shared",
+            Preset::Warm => "warm",
+            Preset::Guided => "guided",
+        }
+    }
+
+    /// The preset of this name.
+    pub fn parse(name: &str) -> Option<Preset> {
+        Preset::ALL.into_iter().find(|p| p.name() == name)
+    }
+
+    fn axes(self) -> (MapSource, Update, MapUse) {
+        use MapSource as S;
+        match self {
+            Preset::Off => (S::None, Update::Off, MapUse::Roulette),
+            Preset::Aggressive => (S::Batch, Update::Aggressive, MapUse::Roulette),
+            Preset::Conservative => (S::Batch, Update::Conservative, MapUse::Roulette),
+            Preset::Shared => (S::Neighbours, Update::Off, MapUse::Roulette),
+            Preset::Warm => (S::Neighbours, Update::Aggressive, MapUse::Roulette),
+            Preset::Guided => (S::Neighbours, Update::Off, MapUse::Proposal),
+        }
+    }
+}
+
+/// Where [`MapSource::Neighbours`] maps come from. Both keep the image independent of
+/// threads.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sharing {
+    /// The gathers before it in its tile, in the tile's fixed pixel order (see
+    /// [`super::neighbours`]): free, but one-sided, and a tile's first gathers have none.
+    TileOrder,
+    /// A learning pass: AIS-off gathers at the centres of `stride × stride` pixel blocks
+    /// over the tile and one block around it, run before the tile (see
+    /// [`super::learning_pass`]): neighbours on every side, for extra gathers.
+    LearningPass {
+        /// Block edge in pixels (1 to [`TILE_SIZE`]).
+        stride: u32,
+    },
+}
+
+/// The learning pass's default block edge, in pixels.
+pub const LEARNING_STRIDE: u32 = 4;
+
+impl Sharing {
+    /// Parses "tile", "pass" (blocks of [`LEARNING_STRIDE`]) or "pass:S" (blocks of S
+    /// pixels).
+    pub fn parse(name: &str) -> Option<Sharing> {
+        match name.split_once(':') {
+            None if name == "tile" => Some(Sharing::TileOrder),
+            None if name == "pass" => Some(Sharing::LearningPass {
+                stride: LEARNING_STRIDE,
+            }),
+            Some(("pass", stride)) => stride
+                .parse()
+                .ok()
+                .filter(|s| (1..=TILE_SIZE as u32).contains(s))
+                .map(|stride| Sharing::LearningPass { stride }),
+            _ => None,
+        }
+    }
+}
+
+/// What a gather's `rays` counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RayBudget {
+    /// About `rays` traced rays per gather: every epoch draws ⌈n_e / acceptance rate⌉
+    /// candidates ([`ais::Stopping::CandidateBudget`]). The talk's reading: AIS buys more
+    /// candidates with the same rays.
+    Traced,
+    /// Exactly `rays` candidates per gather, of which AIS traces only the accepted
+    /// ([`ais::Stopping::FixedCandidates`]): AIS makes each gather cheaper.
+    Candidates,
+}
+
+/// Settings of the multi-ray gather integrator (see the module's parameter table).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GatherSettings {
+    /// The proposal sampler.
+    pub strategy: Strategy,
+    /// Rays (candidates) per gather, n.
+    pub rays: u32,
+    /// What `rays` counts.
+    pub budget: RayBudget,
+    /// Halton (the talk's) or independent random candidates.
+    pub placement: ais::Placement,
+    /// Where the batch's map starts.
+    pub map: MapSource,
+    /// How the batch learns from its own rays.
+    pub update: Update,
+    /// How the map steers the batch.
+    pub map_use: MapUse,
+    /// How a candidate's acceptance probability follows from the map.
+    pub acceptance: Acceptance,
+    /// Where neighbours' maps come from.
+    pub sharing: Sharing,
+    /// The map's tol (a_min = 1 / (tol h²)).
+    pub tol: f32,
+    /// The map's height in texels.
+    pub map_height: u32,
+    /// `map_use = proposal`: the guide's share α of the proposal mixture `(1 − α) p + α g`.
+    pub guide_fraction: f32,
+}
+
+impl Default for GatherSettings {
+    fn default() -> Self {
+        let map = MapConfig::default();
+        GatherSettings {
+            strategy: Strategy::Mis,
+            rays: 16,
+            // Measured: with AIS off, exactly n candidates in one Halton set beat the traced
+            // budget's 4 separately scrambled epochs by 1.27-1.57× at equal time on every
+            // scene, and shared maps gain only with this budget.
+            budget: RayBudget::Candidates,
+            placement: ais::Placement::Halton,
+            // Measured: no AIS setting wins at equal time at the default n = 16 on any of our
+            // scenes, so the renderer starts with AIS off.
+            map: MapSource::None,
+            update: Update::Off,
+            map_use: MapUse::Roulette,
+            acceptance: Acceptance::Affinity,
+            sharing: Sharing::TileOrder,
+            tol: map.tol,
+            map_height: map.height,
+            guide_fraction: super::guiding::GUIDE_FRACTION,
+        }
+    }
+}
+
+fn choose<T: Copy>(value: &str, what: &str, choices: &[(&str, T)]) -> Result<T, String> {
+    choices
+        .iter()
+        .find(|(name, _)| *name == value)
+        .map(|&(_, v)| v)
+        .ok_or_else(|| {
+            let names: Vec<&str> = choices.iter().map(|(name, _)| *name).collect();
+            format!("unknown {what} \"{value}\" ({})", names.join(", "))
+        })
+}
+
+fn number<T: std::str::FromStr>(value: &str, what: &str) -> Result<T, String> {
+    value
+        .trim()
+        .parse()
+        .map_err(|_| format!("{what} \"{value}\" is not a number of the right kind"))
+}
+
+impl GatherSettings {
+    /// The defaults with a preset's map settings.
+    pub fn preset(preset: Preset) -> Self {
+        GatherSettings::default().with_preset(preset)
+    }
+
+    /// These settings with a preset's map settings.
+    pub fn with_preset(self, preset: Preset) -> Self {
+        let (map, update, map_use) = preset.axes();
+        GatherSettings {
+            map,
+            update,
+            map_use,
+            ..self
+        }
+    }
+
+    /// The preset these map settings match, if any.
+    pub fn matching_preset(&self) -> Option<Preset> {
+        Preset::ALL
+            .into_iter()
+            .find(|p| p.axes() == (self.map, self.update, self.map_use))
+    }
+
+    /// Sets the parameter `name` (one of [`PARAMETERS`]) from its text.
+    pub fn set(&mut self, name: &str, value: &str) -> Result<(), String> {
+        match name {
+            "strategy" => {
+                self.strategy = Strategy::parse(value).ok_or_else(|| {
+                    format!("unknown strategy \"{value}\" (uniform, bsdf, light, mis)")
+                })?
+            }
+            "rays" => self.rays = number(value, "rays")?,
+            "budget" => {
+                use RayBudget::*;
+                self.budget = choose(
+                    value,
+                    "budget",
+                    &[("candidates", Candidates), ("traced", Traced)],
+                )?
+            }
+            "placement" => {
+                use ais::Placement::*;
+                self.placement = choose(
+                    value,
+                    "placement",
+                    &[("halton", Halton), ("random", Random)],
+                )?
+            }
+            "ais" => {
+                let presets = Preset::ALL.map(|p| (p.name(), p));
+                *self = self.with_preset(choose(value, "AIS preset", &presets)?)
+            }
+            _ => return self.set_map_parameter(name, value),
+        }
+        Ok(())
+    }
+
+    /// [`GatherSettings::set`] for the map's parameters.
+    fn set_map_parameter(&mut self, name: &str, value: &str) -> Result<(), String> {
+        match name {
+            "map" => {
+                use MapSource::*;
+                self.map = choose(
+                    value,
+                    "map",
+                    &[("none", None), ("batch", Batch), ("neighbours", Neighbours)],
+                )?
+            }
+            "update" => {
+                use Update::*;
+                self.update = choose(
+                    value,
+                    "update",
+                    &[
+                        ("off", Off),
+                        ("aggressive", Aggressive),
+                        ("conservative", Conservative),
+                    ],
+                )?
+            }
+            "map_use" => {
+                use MapUse::*;
+                self.map_use = choose(
+                    value,
+                    "map_use",
+                    &[("roulette", Roulette), ("proposal", Proposal)],
+                )?
+            }
+            "acceptance" => {
+                self.acceptance = Acceptance::parse(value).ok_or_else(|| {
+                    format!("unknown acceptance \"{value}\" (affinity, sqrt, value, efficient)")
+                })?
+            }
+            "sharing" => {
+                self.sharing = Sharing::parse(value).ok_or_else(|| {
+                    format!("unknown sharing \"{value}\" (tile, pass, or pass:S with S in 1..=16)")
+                })?
+            }
+            "tol" => self.tol = number(value, "tol")?,
+            "map_res" => self.map_height = number(value, "map_res")?,
+            "guide_fraction" => self.guide_fraction = number(value, "guide_fraction")?,
+            _ => {
+                return Err(format!(
+                    "unknown gather parameter \"{name}\" (known: {})",
+                    PARAMETERS.join(", ")
+                ))
+            }
+        }
+        Ok(())
+    }
+
+    /// The defaults overridden by the properties of a scene's `<integrator type="gather">`;
+    /// an error names the line.
+    pub fn from_properties(plugin: &Plugin) -> Result<Self, (u32, String)> {
+        let mut settings = GatherSettings::default();
+        if let Some((name, line)) = plugin.unknown_properties(&PARAMETERS).into_iter().next() {
+            return Err((
+                line,
+                format!(
+                    "unknown gather parameter \"{name}\" (known: {})",
+                    PARAMETERS.join(", ")
+                ),
+            ));
+        }
+        for name in PARAMETERS {
+            let Some(property) = plugin.properties.get(name) else {
+                continue;
+            };
+            let text = match &property.value {
+                Property::String(s) => s.clone(),
+                Property::Integer(i) => i.to_string(),
+                Property::Float(f) => f.to_string(),
+                other => {
+                    return Err((
+                        property.line,
+                        format!("\"{name}\" cannot be a {}", other.kind()),
+                    ))
+                }
+            };
+            settings
+                .set(name, &text)
+                .map_err(|message| (property.line, message))?;
+        }
+        settings
+            .validate()
+            .map_err(|message| (plugin.line, message))?;
+        Ok(settings)
+    }
+
+    /// Checks ranges and combinations.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(1..=MOST_RAYS).contains(&self.rays) {
+            return Err(format!("rays must lie in 1..={MOST_RAYS}"));
+        }
+        if self.tol.is_nan() || self.tol <= 0.0 {
+            return Err("tol must be positive (or inf)".into());
+        }
+        if !(1..=LARGEST_MAP_RES).contains(&self.map_height) {
+            return Err(format!("map_res must lie in 1..={LARGEST_MAP_RES}"));
+        }
+        if !(0.0..=0.99).contains(&self.guide_fraction) {
+            return Err("guide_fraction must lie in [0, 0.99]".into());
+        }
+        self.validate_map()
+    }
+
+    fn validate_map(&self) -> Result<(), String> {
+        match (self.map, self.update, self.map_use) {
+            (MapSource::None, Update::Off, MapUse::Roulette) => Ok(()),
+            (MapSource::None, _, _) => {
+                Err("map none (AIS off) takes neither an update nor map_use proposal".into())
+            }
+            (MapSource::Batch, Update::Off, _) => {
+                Err("a per-batch map (map batch) needs an update rule to learn with".into())
+            }
+            (MapSource::Batch, _, MapUse::Proposal) => {
+                Err("map_use proposal needs a fixed map (map neighbours, update off)".into())
+            }
+            (
+                MapSource::Neighbours,
+                Update::Aggressive | Update::Conservative,
+                MapUse::Proposal,
+            ) => Err("map_use proposal needs a fixed map (update off)".into()),
+            (_, _, MapUse::Proposal) if self.acceptance != Acceptance::Affinity => {
+                Err("map_use proposal rejects no candidate, so it takes no acceptance rule".into())
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// Whether each gather starts from maps learned at neighbouring gather points.
+    pub fn shares_maps(&self) -> bool {
+        self.map == MapSource::Neighbours
+    }
+
+    /// Whether AIS is on (the batch has a map).
+    pub fn has_map(&self) -> bool {
+        self.map != MapSource::None
+    }
+
+    /// A short description of the map settings: the preset's name, or the axes.
+    pub fn ais_label(&self) -> String {
+        let axes = self.matching_preset().map_or_else(
+            || {
+                format!(
+                    "map {:?}, update {:?}, use {:?}",
+                    self.map, self.update, self.map_use
+                )
+            },
+            |p| p.name().to_string(),
+        );
+        match self.acceptance {
+            Acceptance::Affinity => axes,
+            other => format!("{axes}, acceptance {}", other.name()),
+        }
+    }
+
+    /// The batch configuration of the library.
+    pub fn batch_config(&self) -> BatchConfig {
+        let base = BatchConfig {
+            stopping: match self.budget {
+                RayBudget::Traced => Stopping::CandidateBudget,
+                RayBudget::Candidates => Stopping::FixedCandidates,
+            },
+            placement: self.placement,
+            ..BatchConfig::default()
+        };
+        if self.map == MapSource::None {
+            return BatchConfig {
+                affinity: None,
+                learning: ais::Learning::Off,
+                ..base
+            };
+        }
+        let map = MapConfig {
+            height: self.map_height,
+            tol: self.tol,
+            ..MapConfig::default()
+        };
+        let (mode, learning) = match self.update {
+            // A fixed map: exactly unbiased.
+            Update::Off => (map.mode, ais::Learning::Off),
+            Update::Aggressive => (Mode::Aggressive, base.learning),
+            Update::Conservative => (Mode::Conservative, base.learning),
+        };
+        BatchConfig {
+            affinity: Some(MapConfig { mode, ..map }),
+            learning,
+            ..base
+        }
+    }
+}

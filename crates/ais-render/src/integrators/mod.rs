@@ -1,0 +1,89 @@
+//! What a camera sample computes: the AIS gather (see [`gather`]), or shading normals and
+//! ambient occlusion for checking geometry.
+
+pub mod ambient_occlusion;
+pub mod gather;
+pub mod normals;
+
+pub use ambient_occlusion::AmbientOcclusion;
+
+use crate::geometry::Ray;
+use crate::render::{RayCounts, SampleIntegrator, Tile, TileState};
+use crate::world::World;
+use ais::rng::Pcg32;
+use gather::{GatherSettings, GatherStats, GatherTile};
+
+/// What to compute at each camera sample.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integrator {
+    /// Direct light gathered at the first hit with `rays` rays through the AIS batch
+    /// driver, plus emitters seen directly.
+    Gather(GatherSettings),
+    /// Shading normal mapped to colour, (n + 1) / 2; black on a miss.
+    Normals,
+    /// Ambient occlusion by cosine-weighted hemisphere rays of bounded length.
+    AmbientOcclusion(AmbientOcclusion),
+}
+
+/// The per-tile state of an [`Integrator`]: the gather's, or none.
+pub enum IntegratorTile {
+    /// The gather's state.
+    Gather(Box<GatherTile>),
+    /// Normals and ambient occlusion keep nothing.
+    Stateless,
+}
+
+impl TileState for IntegratorTile {
+    type Stats = GatherStats;
+
+    fn work(&self) -> u64 {
+        match self {
+            IntegratorTile::Gather(state) => state.work(),
+            IntegratorTile::Stateless => 0,
+        }
+    }
+
+    fn finish(self) -> GatherStats {
+        match self {
+            IntegratorTile::Gather(state) => state.finish(),
+            IntegratorTile::Stateless => GatherStats::default(),
+        }
+    }
+}
+
+impl SampleIntegrator for Integrator {
+    type Tile = IntegratorTile;
+
+    fn begin_tile(&self, world: &World, tile: &Tile, counts: &mut RayCounts) -> IntegratorTile {
+        match self {
+            Integrator::Gather(settings) => IntegratorTile::Gather(Box::new(GatherTile::begin(
+                world,
+                settings,
+                tile,
+                counts,
+                (),
+            ))),
+            _ => IntegratorTile::Stateless,
+        }
+    }
+
+    fn radiance(
+        &self,
+        world: &World,
+        ray: &Ray,
+        rng: &mut Pcg32,
+        state: &mut IntegratorTile,
+        counts: &mut RayCounts,
+    ) -> [f32; 3] {
+        match (self, state) {
+            (Integrator::Gather(settings), IntegratorTile::Gather(state)) => {
+                gather::gather(world, settings, ray, rng, state, counts).to_array()
+            }
+            (Integrator::Normals, _) => normals::normal_colour(world, ray, counts),
+            (Integrator::AmbientOcclusion(ao), _) => ao.value(world, ray, rng, counts),
+            (Integrator::Gather(_), IntegratorTile::Stateless) => {
+                unreachable!("a gather's tiles begin with a gather state")
+            }
+        }
+    }
+}
