@@ -19,7 +19,6 @@ pub mod integrators;
 pub mod lights;
 pub mod mesh;
 pub mod render;
-pub mod sampling;
 pub mod scene;
 pub mod shapes;
 pub mod world;

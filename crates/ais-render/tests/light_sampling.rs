@@ -4,9 +4,9 @@
 
 mod common;
 
-use ais::chi2::chi_square_p_value;
 use ais::mapping::LatLong;
 use ais::rng::Pcg32;
+use ais::testing::{ChiSquareTest, Drawn};
 use ais_render::bsdf::{Material, Microfacet, RoughPlastic, Scattering, ShadingFrame};
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
@@ -16,78 +16,32 @@ use ais_render::lights::{
 };
 use base64::Engine;
 use glam::{DMat3, Vec3};
-use std::f32::consts::PI;
 
-const ROWS: u32 = 24;
-const SUBDIVISION: u32 = 32;
 const SIGNIFICANCE: f64 = 0.01;
 
 /// Samples `count` directions and returns the chi-square p-value against the integral of
-/// `pdf` over each bin (midpoint rule on equal-area sub-cells). Also checks that each
-/// sample's reported density equals `pdf` at its direction.
+/// `pdf` over each bin (the shared harness, [`ChiSquareTest`]), after checking that each
+/// sample's reported density equals `pdf` at its direction and that the density integrates
+/// to the share of draws that gave a sample.
 fn fit(
     count: u32,
     seed: u64,
     sample: impl Fn([f32; 2]) -> Option<(Vec3, f64)>,
     pdf: impl Fn(Vec3) -> f64,
 ) -> f64 {
-    let layout = LatLong::new(ROWS);
-    let mut observed = vec![0.0; layout.texel_count()];
-    let mut rng = Pcg32::new(seed, 11);
-    let mut drawn = 0;
-    let mut mismatched = 0;
-    for _ in 0..count {
-        let Some((direction, density)) = sample([rng.next_f32(), rng.next_f32()]) else {
-            continue;
-        };
-        let reference = pdf(direction);
-        // Rounding can move a direction sampled at a texel edge across it: allow that rarely.
-        if (density - reference).abs() > 1e-3 * reference.max(1e-3) {
-            mismatched += 1;
-        }
-        observed[layout.index(layout.texel(direction))] += 1.0;
-        drawn += 1;
-    }
-    assert!(
-        mismatched * 1000 <= drawn,
-        "{mismatched} of {drawn} samples report a density that differs from pdf()"
+    let test = ChiSquareTest {
+        samples: count,
+        seed,
+        ..ChiSquareTest::default()
+    };
+    let outcome = test.run(
+        |u| sample(u).map(|(direction, density)| Drawn::with_pdf(direction, density)),
+        pdf,
     );
-    let mut expected = vec![0.0; layout.texel_count()];
-    let mut total = 0.0;
-    for (index, slot) in expected.iter_mut().enumerate() {
-        let texel = layout.texel_of_index(index);
-        let (z0, z1) = (
-            (PI * texel.row as f32 / ROWS as f32).cos(),
-            (PI * (texel.row + 1) as f32 / ROWS as f32).cos(),
-        );
-        let (phi0, phi1) = (
-            2.0 * PI * texel.column as f32 / layout.width() as f32,
-            2.0 * PI * (texel.column + 1) as f32 / layout.width() as f32,
-        );
-        let cell = (z0 - z1) * (phi1 - phi0) / (SUBDIVISION * SUBDIVISION) as f32;
-        let mut integral = 0.0;
-        for i in 0..SUBDIVISION {
-            for j in 0..SUBDIVISION {
-                let z = z0 + (z1 - z0) * (i as f32 + 0.5) / SUBDIVISION as f32;
-                let phi = phi0 + (phi1 - phi0) * (j as f32 + 0.5) / SUBDIVISION as f32;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                integral += pdf(Vec3::new(r * phi.cos(), r * phi.sin(), z)) * cell as f64;
-            }
-        }
-        total += integral;
-        *slot = integral;
+    if let Some(problem) = outcome.consistency_problem() {
+        panic!("{problem}");
     }
-    // The density integrates to the probability that a sample is produced at all (samples
-    // of a microfacet BSDF can leave the hemisphere, for instance).
-    let produced = drawn as f64 / count as f64;
-    assert!(
-        (total - produced).abs() < 0.02,
-        "the density integrates to {total}, but {produced} of the draws gave a sample"
-    );
-    for e in &mut expected {
-        *e *= count as f64;
-    }
-    chi_square_p_value(&observed, &expected)
+    outcome.p_value
 }
 
 fn gradient_with_sun(width: usize, height: usize) -> RgbImage {

@@ -3,9 +3,9 @@
 //! Each figure is the median of several runs measured in one process.
 
 use ais::rng::Pcg32;
+use ais::sampling::cosine_hemisphere;
 use ais_render::default_scene::default_world;
 use ais_render::geometry::{basis, spawn_ray, Geometry};
-use ais_render::sampling::cosine_hemisphere;
 use ais_render::world::World;
 use rayon::prelude::*;
 use std::time::Instant;

@@ -81,7 +81,7 @@ fn run_batch(batch: &mut Batch<f32>, dirs: &[Vec3], seed: u64) -> f32 {
 fn decide_record(c: &mut Criterion) {
     let dirs = directions(4096);
     let mut group = c.benchmark_group("decide+record per candidate");
-    let mut configs: Vec<(String, BatchConfig)> = vec![("off".into(), BatchConfig::off())];
+    let mut configs: Vec<(String, BatchConfig)> = vec![("off".into(), BatchConfig::talk_off())];
     for (name, map) in map_configs() {
         configs.push((
             format!("default schedule, {name}"),

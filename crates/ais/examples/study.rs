@@ -202,14 +202,14 @@ fn all_scenes() -> Vec<Scene> {
 fn random_off() -> BatchConfig {
     BatchConfig {
         placement: Placement::Random,
-        ..BatchConfig::off()
+        ..BatchConfig::talk_off()
     }
 }
 
 fn budget_off() -> BatchConfig {
     BatchConfig {
         stopping: Stopping::CandidateBudget,
-        ..BatchConfig::off()
+        ..BatchConfig::talk_off()
     }
 }
 
@@ -217,7 +217,7 @@ fn budget_off() -> BatchConfig {
 fn reference_setups() -> Vec<Setup> {
     vec![
         Setup::new("off, random", random_off()),
-        Setup::new("off, Halton", BatchConfig::off()),
+        Setup::new("off, Halton", BatchConfig::talk_off()),
         Setup::oracle("oracle, random, n+1", random_off()),
         Setup::oracle("oracle, Halton, budget", budget_off()),
     ]
@@ -313,7 +313,7 @@ fn rules_section(batches: u32) {
 
 /// Map height sweep for the default schedule.
 fn heights_section(batches: u32) {
-    let mut setups = vec![Setup::new("off, Halton", BatchConfig::off())];
+    let mut setups = vec![Setup::new("off, Halton", BatchConfig::talk_off())];
     for mode in [Mode::Conservative, Mode::Aggressive] {
         for height in [2u32, 4, 8, 16, 32] {
             let label = format!(
@@ -350,7 +350,7 @@ fn placement_section(batches: u32) {
     let default = BatchConfig::default();
     let setups = vec![
         Setup::new("off, random", random_off()),
-        Setup::new("off, Halton", BatchConfig::off()),
+        Setup::new("off, Halton", BatchConfig::talk_off()),
         Setup::new(
             "default AIS, random, n+1",
             BatchConfig {
@@ -489,7 +489,7 @@ fn stopping_section(batches: u32) {
 /// The uniform-sphere proposal (half of its candidates are unconditional rejections).
 fn proposals_section(batches: u32) {
     let setups = vec![
-        Setup::new("off, Halton, n+1", BatchConfig::off()),
+        Setup::new("off, Halton, n+1", BatchConfig::talk_off()),
         Setup::new("off, Halton, budget", budget_off()),
         Setup::oracle("oracle, Halton, budget", budget_off()),
         Setup::new("default AIS", BatchConfig::default()),

@@ -2,7 +2,7 @@
 //! direction is to be worth tracing.
 //!
 //! Every texel holds the talk's three channels, `[affinity sum s, weight sum ω, reset
-//! counter]`, plus a count of recorded rays (used by [`LevelRule::FinestWithSamples`]). A
+//! counter]`, plus a count of recorded rays (used by a study-only level rule). A
 //! fresh texel has `[s, ω] = [1, 1]`, i.e. affinity 1. With `h` the height of the texel's
 //! level, the affinity is
 //!
@@ -40,13 +40,16 @@ pub enum LevelRule {
     Single,
     /// The talk's literal reading: `count` levels of heights `h, h/2, h/4, …`; every level is
     /// updated, and the lookup uses the finest level whose affinity is below 1, else 1.
+    /// Study only: it raised the bias of the n+1 rule and lost to a single level.
+    #[cfg(feature = "study")]
     FinestBelowOne {
         /// Number of levels (at most [`MAX_LEVELS`], and no coarser than height 1).
         count: u32,
     },
     /// `count` levels as above; the lookup uses the finest level whose texel has recorded at
     /// least `min_samples` rays, else 1. Coarse levels answer early, fine levels take over
-    /// once they have evidence.
+    /// once they have evidence. Study only: it learned fast and raised the bias most.
+    #[cfg(feature = "study")]
     FinestWithSamples {
         /// Number of levels (at most [`MAX_LEVELS`], and no coarser than height 1).
         count: u32,
@@ -60,6 +63,7 @@ impl LevelRule {
     pub fn level_count(self) -> u32 {
         match self {
             LevelRule::Single => 1,
+            #[cfg(feature = "study")]
             LevelRule::FinestBelowOne { count } | LevelRule::FinestWithSamples { count, .. } => {
                 count
             }
@@ -81,7 +85,7 @@ pub struct MapConfig {
 }
 
 impl Default for MapConfig {
-    /// The defaults chosen from the study in BENCHMARKS.md.
+    /// The defaults chosen by measurement: one level of height 4, tol 1, aggressive.
     fn default() -> Self {
         MapConfig {
             height: 4,
@@ -332,12 +336,14 @@ impl AffinityMap {
             LevelRule::Single => {
                 Self::affinity_of(self.state(texels[0] as usize), self.levels[0].min_affinity)
             }
+            #[cfg(feature = "study")]
             LevelRule::FinestBelowOne { .. } => (0..self.level_count)
                 .map(|l| {
                     Self::affinity_of(self.state(texels[l] as usize), self.levels[l].min_affinity)
                 })
                 .find(|&a| a < 1.0)
                 .unwrap_or(1.0),
+            #[cfg(feature = "study")]
             LevelRule::FinestWithSamples { min_samples, .. } => (0..self.level_count)
                 .map(|l| (l, self.state(texels[l] as usize)))
                 .find(|(_, state)| state.samples >= min_samples)

@@ -39,12 +39,16 @@ use glam::Vec3;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Learning {
     /// The talk's rule: every traced ray updates the map at once. Not exactly unbiased, since
-    /// acceptance probabilities change inside the batch (see BENCHMARKS.md for the measured bias).
+    /// acceptance probabilities change inside the batch (a positive bias of up to several
+    /// standard errors with fast-learning maps). Study only: kept to measure that bias and to
+    /// reproduce the talk.
+    #[cfg(feature = "study")]
     Continuous,
-    /// Frozen-map epochs (see [`crate::epochs`]): exactly unbiased. `epochs` is the number of
+    /// Frozen-map epochs: the map changes only between epochs, each run under a fixed map,
+    /// so each epoch is exactly unbiased given the past. `epochs` is the number of
     /// doubling epochs, e.g. 4 gives `n/8, n/8, n/4, n/2`.
     Epochs {
-        /// Number of epochs (1..=[`crate::epochs::MAX_EPOCHS`]).
+        /// Number of epochs (1..=[`crate::MAX_EPOCHS`]).
         epochs: u32,
     },
     /// The map is used but never updated (a fixed map, e.g. learned elsewhere): exactly unbiased.
@@ -67,7 +71,9 @@ pub enum Stopping {
     /// untraced, and divide by the number of candidates before it. Unbiased for independent
     /// candidates and a fixed acceptance probability, i.e. with [`Placement::Random`]. With
     /// Halton placement the stopping time depends on correlated points and the estimate is
-    /// biased low (measured in BENCHMARKS.md: about −4% at n = 8 even for a fixed map).
+    /// biased low (about −4% at n = 8 even for a fixed map). Study only: kept to reproduce
+    /// the talk and to measure that bias.
+    #[cfg(feature = "study")]
     DropLast,
     /// Our rule for stratified placement: every epoch draws a fixed number of candidates
     /// `M_e = ⌈n_e / q⌉`, where `q` is the acceptance rate (traced per candidate) of the
@@ -85,7 +91,8 @@ pub enum Stopping {
     /// [`Stopping::CandidateBudget`] does.
     FixedCandidates,
     /// Stop at the `n`-th accepted candidate. Biased toward high-affinity directions (the
-    /// talk's "families until n boys"); offered only to measure that bias.
+    /// talk's "families until n boys"). Study only: kept to measure that bias.
+    #[cfg(feature = "study")]
     AtN,
 }
 
@@ -108,7 +115,8 @@ pub struct BatchConfig {
 }
 
 impl Default for BatchConfig {
-    /// The defaults chosen from the study in BENCHMARKS.md.
+    /// The defaults chosen by measurement: a single-level map of height 4, 4 frozen-map
+    /// epochs, Halton placement and the candidate-budget stopping rule.
     fn default() -> Self {
         BatchConfig {
             affinity: Some(MapConfig::default()),
@@ -121,17 +129,24 @@ impl Default for BatchConfig {
 }
 
 impl BatchConfig {
-    /// AIS off: a plain batch of `n` traced rays (the baseline every mode is compared with).
-    ///
-    /// It keeps the talk's n+1 rule: with no map and a proposal that stays inside the
-    /// support, every candidate is traced, so exactly `n` are and the rule is exact with any
-    /// placement.
+    /// AIS off: a plain batch of `n` candidates, every one inside the support traced (the
+    /// baseline every mode is compared with).
     pub fn off() -> Self {
         BatchConfig {
             affinity: None,
             learning: Learning::Off,
-            stopping: Stopping::DropLast,
+            stopping: Stopping::FixedCandidates,
             ..BatchConfig::default()
+        }
+    }
+
+    /// AIS off with the talk's n+1 rule ([`Stopping::DropLast`]): `n` traced rays exactly.
+    /// Study only: the baseline of the talk's comparisons and of the library's study.
+    #[cfg(feature = "study")]
+    pub fn talk_off() -> Self {
+        BatchConfig {
+            stopping: Stopping::DropLast,
+            ..BatchConfig::off()
         }
     }
 }
@@ -214,9 +229,9 @@ pub enum BatchConfigError {
     Map(MapConfigError),
     /// The candidate cap is 0.
     ZeroCandidateCap,
-    /// The epoch count is 0 or above [`crate::epochs::MAX_EPOCHS`].
+    /// The epoch count is 0 or above [`crate::MAX_EPOCHS`].
     BadEpochCount(u32),
-    /// [`Stopping::CandidateBudget`] with [`Learning::Continuous`]: the map would change
+    /// [`Stopping::CandidateBudget`] with continuous learning (a study option): the map would change
     /// inside an epoch of fixed size.
     BudgetNeedsFrozenMap,
 }
@@ -281,6 +296,7 @@ impl<V: Value> Batch<V> {
         if config.candidate_cap == 0 {
             return Err(BatchConfigError::ZeroCandidateCap);
         }
+        #[cfg(feature = "study")]
         if matches!(
             config.stopping,
             Stopping::CandidateBudget | Stopping::FixedCandidates
@@ -402,7 +418,6 @@ impl<V: Value> Batch<V> {
                 EpochPlan::doubling(n, epochs)
             }
             (_, Stopping::CandidateBudget) => EpochPlan::doubling(n, 4),
-            (_, Stopping::FixedCandidates) => EpochPlan::single(n),
             _ => EpochPlan::single(n),
         };
         if self.deferred.capacity() < n as usize {
@@ -450,15 +465,51 @@ impl<V: Value> Batch<V> {
                 ((size as f64 / rate).ceil() as u32).clamp(size, cap)
             }
             Stopping::FixedCandidates => size,
+            #[cfg(feature = "study")]
             Stopping::DropLast | Stopping::AtN => cap,
         };
     }
 
-    /// The next candidate, or `None` when the batch is complete.
+    /// The next candidate, with numbers from the batch's [`Placement`], or `None` when the
+    /// batch is complete.
     ///
     /// # Panics
     /// If the previous candidate was accepted for tracing but not recorded.
     pub fn next_candidate(&mut self) -> Option<Candidate> {
+        self.advance()?;
+        let index = self.next_index - 1;
+        let [u1, u2, u3] = match self.config.placement {
+            Placement::Halton => self.halton.point(index),
+            Placement::Random => [
+                self.rng.next_f32(),
+                self.rng.next_f32(),
+                self.rng.next_f32(),
+            ],
+        };
+        self.acceptance = u3;
+        Some(Candidate { index, u: [u1, u2] })
+    }
+
+    /// The next candidate with the host's own numbers `u` ∈ [0, 1)³ instead of the batch's
+    /// placement (for a host with its own sampler): `u[0]` and `u[1]` come back in the
+    /// candidate for the host's proposal, `u[2]` decides the roulette. `None` when the batch
+    /// is complete. Exactly unbiased when the host's numbers are uniform and independent of
+    /// the map, as the built-in placements are.
+    ///
+    /// # Panics
+    /// If the previous candidate was accepted for tracing but not recorded.
+    pub fn next_candidate_with(&mut self, u: [f32; 3]) -> Option<Candidate> {
+        self.advance()?;
+        self.acceptance = u[2];
+        Some(Candidate {
+            index: self.next_index - 1,
+            u: [u[0], u[1]],
+        })
+    }
+
+    /// Moves to the next candidate (closing an epoch whose candidates are spent); `None`
+    /// when the batch is complete.
+    fn advance(&mut self) -> Option<()> {
         assert!(
             self.pending.is_none(),
             "Batch::record must follow a Decision::Trace before the next candidate"
@@ -475,23 +526,14 @@ impl<V: Value> Batch<V> {
         if self.done {
             return None;
         }
-        let index = self.next_index;
         self.next_index += 1;
-        let [u1, u2, u3] = match self.config.placement {
-            Placement::Halton => self.halton.point(index),
-            Placement::Random => [
-                self.rng.next_f32(),
-                self.rng.next_f32(),
-                self.rng.next_f32(),
-            ],
-        };
-        self.acceptance = u3;
-        Some(Candidate { index, u: [u1, u2] })
+        Some(())
     }
 
-    /// Decides whether the current candidate, in `direction` (unit, in the map's frame), is
-    /// traced. `in_support` is false for directions outside the BSDF's support.
-    pub fn decide(&mut self, direction: Vec3, in_support: bool) -> Decision {
+    /// Decides whether the current candidate, in `direction` (unit, in the map's frame; any
+    /// `[f32; 3]`-like vector, such as a glam `Vec3` of any version), is traced. `in_support`
+    /// is false for directions outside the BSDF's support.
+    pub fn decide(&mut self, direction: impl Into<[f32; 3]>, in_support: bool) -> Decision {
         self.decide_with(direction, in_support, |affinity| affinity)
     }
 
@@ -503,7 +545,7 @@ impl<V: Value> Batch<V> {
     /// Values above 1 count as 1; 0 or NaN rejects the candidate.
     pub fn decide_with(
         &mut self,
-        direction: Vec3,
+        direction: impl Into<[f32; 3]>,
         in_support: bool,
         acceptance: impl FnOnce(f32) -> f32,
     ) -> Decision {
@@ -514,6 +556,7 @@ impl<V: Value> Batch<V> {
             self.batch_stats.rejected_outside_support += 1;
             return Decision::Reject(RejectReason::OutsideSupport);
         }
+        let direction = Vec3::from(direction.into());
         let lookup = self.map.as_ref().map(|map| map.lookup(direction));
         let chosen = acceptance(lookup.map_or(1.0, |l| l.affinity));
         // An acceptance of 0 (or NaN) always rejects, as an affinity of 0 would.
@@ -526,8 +569,10 @@ impl<V: Value> Batch<V> {
             self.batch_stats.rejected_roulette += 1;
             return Decision::Reject(RejectReason::Roulette);
         }
-        let target = self.plan.sizes()[self.epoch];
-        if self.config.stopping == Stopping::DropLast && self.epoch_accepted == target {
+        #[cfg(feature = "study")]
+        if self.config.stopping == Stopping::DropLast
+            && self.epoch_accepted == self.plan.sizes()[self.epoch]
+        {
             // The (n_e + 1)-th acceptance: not traced and not counted.
             self.epoch_candidates -= 1;
             self.batch_stats.candidates -= 1;
@@ -563,11 +608,12 @@ impl<V: Value> Batch<V> {
         if let (Some(observations), Some(lookup)) = (self.observations.as_mut(), pending.lookup) {
             observations.record(&lookup, rating.clamp(0.0, 1.0), pending.affinity);
         }
-        if let (Some(map), Some(lookup)) = (self.map.as_mut(), pending.lookup) {
+        if let (Some(_map), Some(lookup)) = (self.map.as_mut(), pending.lookup) {
             let rating = rating.clamp(0.0, 1.0);
             match self.config.learning {
+                #[cfg(feature = "study")]
                 Learning::Continuous => {
-                    let outcome = map.record(&lookup, rating, pending.affinity);
+                    let outcome = _map.record(&lookup, rating, pending.affinity);
                     self.batch_stats.resets += outcome.resets as u64;
                 }
                 Learning::Epochs { .. } => self.deferred.push(DeferredUpdate {
@@ -578,8 +624,10 @@ impl<V: Value> Batch<V> {
                 Learning::Off => {}
             }
         }
-        let target = self.plan.sizes()[self.epoch];
-        if self.config.stopping == Stopping::AtN && self.epoch_accepted == target {
+        #[cfg(feature = "study")]
+        if self.config.stopping == Stopping::AtN
+            && self.epoch_accepted == self.plan.sizes()[self.epoch]
+        {
             self.close_epoch();
         }
     }
@@ -671,8 +719,8 @@ mod tests {
         .unwrap();
         let estimate = drive(&mut batch, 64, 3, MapStart::Empty);
         let stats = batch.stats();
-        assert_eq!(estimate.traced, 64);
-        assert_eq!(stats.dropped, 1);
+        assert_eq!(estimate.candidates, 64);
+        assert_eq!(stats.dropped, 0);
         assert_eq!(stats.rejected_roulette, 0);
         assert_eq!(
             stats.candidates,

@@ -56,6 +56,7 @@ impl EpochPlan {
     }
 
     /// The total number of rays (n).
+    #[cfg(test)]
     pub fn total(&self) -> u32 {
         self.sizes().iter().sum()
     }

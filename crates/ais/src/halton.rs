@@ -106,6 +106,7 @@ impl ScrambledHalton {
     }
 
     /// A sequence scrambled with permutations drawn from `seed`.
+    #[cfg(test)]
     pub fn scrambled(seed: u64) -> Self {
         let mut sequence = Self::unscrambled();
         sequence.rescramble(seed);
@@ -134,6 +135,7 @@ impl ScrambledHalton {
     /// The digit permutation applied at `position` in `base` (2, 3 or 5), for inspection.
     ///
     /// Returns `None` for another base or a position beyond the stored digits.
+    #[cfg(test)]
     pub fn digit_permutation(&self, base: u32, position: usize) -> Option<Vec<u8>> {
         match base {
             2 if position < 32 => {

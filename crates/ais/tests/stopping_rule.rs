@@ -100,14 +100,14 @@ fn halton_placement_biases_the_n_plus_one_rule_but_not_the_candidate_budget() {
                 GatherTarget::Oracle,
             )
         };
-        let halton_n_plus_one = oracle(BatchConfig::off());
+        let halton_n_plus_one = oracle(BatchConfig::talk_off());
         let halton_budget = oracle(BatchConfig {
             stopping: Stopping::CandidateBudget,
-            ..BatchConfig::off()
+            ..BatchConfig::talk_off()
         });
         let random_n_plus_one = oracle(BatchConfig {
             placement: Placement::Random,
-            ..BatchConfig::off()
+            ..BatchConfig::talk_off()
         });
         let exact = scene.exact();
         println!(

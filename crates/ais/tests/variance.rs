@@ -35,7 +35,7 @@ fn default_ais_beats_no_ais_with_halton_placement() {
         (Scene::window(0.35), 256, 1.3), // measured 1.50×
     ];
     for (scene, n, minimum) in cases {
-        let measured = gain(&scene, n, BatchConfig::off(), BatchConfig::default());
+        let measured = gain(&scene, n, BatchConfig::talk_off(), BatchConfig::default());
         assert!(
             measured > minimum,
             "{} n = {n}: gain {measured:.2}",
@@ -62,7 +62,7 @@ fn ais_beats_no_ais_with_random_placement() {
         let measured = gain(
             &scene,
             n,
-            random(BatchConfig::off()),
+            random(BatchConfig::talk_off()),
             random(BatchConfig::default()),
         );
         assert!(

@@ -10,8 +10,8 @@ pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, Microfac
 pub use rough_plastic::RoughPlastic;
 
 use crate::geometry::basis;
-use crate::sampling::cosine_hemisphere;
 use crate::scene::{Plugin, Property};
+use ais::sampling::cosine_hemisphere;
 use glam::Vec3;
 use std::f32::consts::PI;
 

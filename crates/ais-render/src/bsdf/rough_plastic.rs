@@ -17,7 +17,7 @@
 //! is about 1.5% below the exact integral for η = 1.5 and changes the diffuse term by 2%.
 
 use super::microfacet::{fresnel_dielectric, Microfacet, MicrofacetKind};
-use crate::sampling::cosine_hemisphere;
+use ais::sampling::cosine_hemisphere;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::f32::consts::PI;

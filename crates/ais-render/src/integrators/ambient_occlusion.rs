@@ -3,9 +3,9 @@
 
 use crate::geometry::{basis, spawn_ray, Ray};
 use crate::render::RayCounts;
-use crate::sampling::cosine_hemisphere;
 use crate::world::World;
 use ais::rng::Pcg32;
+use ais::sampling::cosine_hemisphere;
 
 /// Ambient-occlusion settings.
 #[derive(Clone, Copy, Debug, PartialEq)]

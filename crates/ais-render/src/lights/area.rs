@@ -4,7 +4,7 @@
 
 use super::spherical_rectangle::Rectangle;
 use crate::geometry::{Ray, Sphere, Triangle};
-use crate::sampling::Distribution1D;
+use ais::sampling::Distribution1D;
 use glam::Vec3;
 use std::f64::consts::PI;
 

@@ -12,8 +12,8 @@
 //! so the density is positive wherever the interpolated radiance is.
 
 use crate::image_io::RgbImage;
-use crate::sampling::uniform_sphere;
-use crate::sampling::Distribution2D;
+use ais::sampling::uniform_sphere;
+use ais::sampling::Distribution2D;
 use glam::{DMat3, DVec3, Vec3};
 use std::f64::consts::PI;
 

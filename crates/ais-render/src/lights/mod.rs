@@ -12,7 +12,7 @@ pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
 pub use spherical_rectangle::Rectangle;
 
 use crate::geometry::Ray;
-use crate::sampling::Distribution1D;
+use ais::sampling::Distribution1D;
 use glam::Vec3;
 use std::f64::consts::PI;
 

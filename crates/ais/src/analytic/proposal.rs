@@ -1,5 +1,6 @@
 //! Proposal samplers for the analytic scenes.
 
+use crate::sampling::warp::{cosine_hemisphere, uniform_sphere};
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -16,20 +17,13 @@ pub enum Proposal {
 impl Proposal {
     /// Maps `u` ∈ [0, 1)² to a unit direction and its density (per steradian).
     pub fn sample(self, u: [f32; 2]) -> (DVec3, f64) {
-        let (u1, u2) = (u[0] as f64, u[1] as f64);
-        let phi = 2.0 * PI * u2;
-        match self {
-            Proposal::UniformSphere => {
-                let z = 1.0 - 2.0 * u1;
-                let r = (1.0 - z * z).max(0.0).sqrt();
-                (DVec3::new(r * phi.cos(), r * phi.sin(), z), 0.25 / PI)
-            }
-            Proposal::CosineHemisphere => {
-                let r = u1.sqrt();
-                let z = (1.0 - u1).max(0.0).sqrt();
-                (DVec3::new(r * phi.cos(), r * phi.sin(), z), z / PI)
-            }
+        let direction = match self {
+            Proposal::UniformSphere => uniform_sphere(u),
+            Proposal::CosineHemisphere => cosine_hemisphere(u),
         }
+        .as_dvec3()
+        .normalize();
+        (direction, self.pdf(direction))
     }
 
     /// Density of a unit direction.

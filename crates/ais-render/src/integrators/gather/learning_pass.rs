@@ -2,12 +2,12 @@
 //! tile is rendered, gathers at a coarse grid of points around it trace their rays with AIS
 //! off and keep what they saw; every gather of the tile then blends the learned maps near
 //! it (within `stride` pixel footprints), together with the tile's earlier gathers of
-//! [`super::neighbours::RecentGathers`].
+//! [`ais::shared::RecentGathers`].
 //!
 //! The grid has one learning gather per `stride × stride` block of pixels, at the block's
 //! centre, and covers the tile plus one block on every side, so every gather point, even at
 //! a tile's edge, has learned neighbours all around it (the tile-order source of
-//! [`super::neighbours::RecentGathers`] only has the gathers before it). A block's learning
+//! [`ais::shared::RecentGathers`] only has the gathers before it). A block's learning
 //! gather depends only on the render seed and the block, never on which tile or thread
 //! computes it, so the image is the same for any number of threads. The maps are fixed
 //! while the tile renders, so every gather of it is exactly unbiased.
@@ -18,11 +18,11 @@
 
 use super::batch_loop::{run_batch, BatchRun};
 use super::guiding::CandidateSampler;
-use super::neighbours::Neighbour;
 use super::{gather_point, Acceptance, GatherSettings, MapSource, MapUse, Update};
 use crate::render::{PixelRect, RayCounts, Tile};
 use crate::world::World;
 use ais::rng::{mix64, Pcg32};
+use ais::shared::Neighbour;
 use ais::{Batch, MapStart};
 
 /// Seeds of learning gathers are drawn from a domain apart from the pixels' seeds, so that a
@@ -141,18 +141,18 @@ impl LearningPass {
             start: MapStart::Empty,
         };
         run_batch(&run, batch, counts, &mut ());
-        Some(Neighbour {
-            point: hit.point,
-            normal: at.frame.normal,
-            observations: batch
-                .observations()
-                .expect("learning gathers observe their rays")
-                .clone(),
-        })
+        let observations = batch
+            .observations()
+            .expect("learning gathers observe their rays");
+        Some(Neighbour::new(
+            hit.point,
+            at.frame.normal,
+            observations.clone(),
+        ))
     }
 
     /// The learned maps around the current tile.
-    pub(crate) fn neighbours(&self) -> &[Neighbour] {
+    pub fn neighbours(&self) -> &[Neighbour] {
         &self.cells
     }
 

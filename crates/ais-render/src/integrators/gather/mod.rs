@@ -5,7 +5,8 @@
 //! - [`strategy`]: the proposal samplers (uniform, BSDF, light, MIS);
 //! - [`acceptance`]: roulette's acceptance rules;
 //! - [`batch_loop`]: one batch through the library's driver;
-//! - [`neighbours`] and [`learning_pass`]: maps shared between gathers;
+//! - [`learning_pass`]: maps learned around a tile before it renders (with the tile's
+//!   recent gathers of [`ais::shared`], the sources of shared maps);
 //! - [`guiding`]: a fixed map folded into the proposal.
 
 pub mod acceptance;
@@ -13,7 +14,6 @@ pub mod batch_loop;
 pub mod guiding;
 pub mod learning_pass;
 mod light;
-pub mod neighbours;
 pub mod settings;
 pub mod strategy;
 
@@ -28,11 +28,15 @@ use crate::geometry::{Hit, Ray};
 use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
 use ais::rng::Pcg32;
+use ais::shared::{blend_neighbours, NeighbourSource, RecentGathers};
 use ais::{Batch, MapStart};
 use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
-use neighbours::{blend_neighbours, NeighbourSource, RecentGathers, RADIUS_PIXELS};
+
+/// The radius of a gather's neighbourhood among the tile's recent gathers, in pixel
+/// footprints at the gather point.
+pub const RADIUS_PIXELS: f32 = 3.0;
 
 /// What a render's gathers report: the batches' counters and the AIS memory a thread held.
 #[derive(Clone, Copy, Debug, Default)]

@@ -3,7 +3,7 @@
 
 use crate::bsdf::{Material, ShadingFrame};
 use crate::lights::{EnvironmentGuide, Lights};
-use crate::sampling::uniform_sphere;
+use ais::sampling::uniform_sphere;
 use glam::Vec3;
 use std::f64::consts::PI;
 

@@ -1,5 +1,5 @@
-//! Pearson's chi-square goodness-of-fit test, as Mitsuba 3's `chi2` tests use it for warps
-//! and emitters: hosts can validate their own proposal samplers with it.
+//! Pearson's chi-square goodness-of-fit statistic and its p-value, pooling sparse cells as
+//! Mitsuba 3's chi2 tests do.
 
 /// Upper tail probability of the chi-square distribution with `dof` degrees of freedom.
 pub fn chi_square_tail(statistic: f64, dof: f64) -> f64 {

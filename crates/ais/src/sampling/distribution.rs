@@ -193,7 +193,7 @@ mod tests {
 
     #[test]
     fn the_guide_table_finds_the_bin_a_binary_search_finds() {
-        let mut rng = ais::rng::Pcg32::new(8, 8);
+        let mut rng = crate::rng::Pcg32::new(8, 8);
         for size in [1usize, 2, 3, 7, 64, 257] {
             // Uneven weights with runs of zeros, as a sky with a sun has.
             let weights: Vec<f64> = (0..size)
@@ -228,7 +228,7 @@ mod tests {
     fn two_dimensional_sample_pdf_and_invert_agree() {
         let weights: Vec<f64> = (0..12).map(|i| (i % 5) as f64 + 0.5).collect();
         let d = Distribution2D::new(&weights, 4, 3);
-        let mut rng = ais::rng::Pcg32::new(3, 3);
+        let mut rng = crate::rng::Pcg32::new(3, 3);
         let mut integral = 0.0;
         for _ in 0..1000 {
             let u = [rng.next_f64(), rng.next_f64()];

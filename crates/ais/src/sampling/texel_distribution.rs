@@ -145,7 +145,7 @@ impl TexelDistribution {
         Vec3::new(sin_theta * cos_phi, sin_theta * sin_phi, cos_theta)
     }
 
-    /// The texel holding a unit `direction`: row `r` holds cos θ ∈ (c[r+1], c[r]] (the last
+    /// The texel holding a unit `direction`: row `r` holds cos θ ∈ (c\[r+1\], c\[r\]] (the last
     /// row also −1) for the stored boundary cosines c, column `c` holds φ ∈ [c, c+1)·2π/width.
     pub fn texel_of(&self, direction: Vec3) -> Texel {
         let h = self.layout.height();
@@ -167,6 +167,25 @@ impl TexelDistribution {
         Texel { row, column }
     }
 
+    /// The `u` that [`TexelDistribution::sample`] maps to a unit `direction` in a texel with
+    /// mass: the inverse of sampling, for hosts that stratify or reuse sample values.
+    pub fn invert(&self, direction: Vec3) -> [f32; 2] {
+        let texel = self.texel_of(direction);
+        let index = self.layout.index(texel);
+        let mut phi = direction.y.atan2(direction.x);
+        if phi < 0.0 {
+            phi += TAU;
+        }
+        let s = (phi / TAU * self.layout.width() as f32 - texel.column as f32).clamp(0.0, 1.0);
+        let (top, bottom) = (
+            self.row_cosines[texel.row as usize],
+            self.row_cosines[texel.row as usize + 1],
+        );
+        let t = ((top - direction.z.clamp(-1.0, 1.0)) / (top - bottom)).clamp(0.0, 1.0);
+        let probability = self.cdf[index + 1] - self.cdf[index];
+        [self.cdf[index] + s * probability, t]
+    }
+
     /// Density of [`TexelDistribution::sample`] at a unit `direction`, in solid angle.
     pub fn pdf(&self, direction: Vec3) -> f32 {
         self.density[self.layout.index(self.texel_of(direction))]
@@ -176,6 +195,20 @@ impl TexelDistribution {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn invert_undoes_sample() {
+        let mut distribution = TexelDistribution::new(LatLong::new(4));
+        distribution.set_weights(|texel| 1.0 + texel.column as f32 + 3.0 * texel.row as f32);
+        for (i, j) in (1..20).flat_map(|i| (1..20).map(move |j| (i, j))) {
+            let u = [i as f32 / 20.0, j as f32 / 20.0];
+            let back = distribution.invert(distribution.sample(u));
+            assert!(
+                (back[0] - u[0]).abs() < 1e-4 && (back[1] - u[1]).abs() < 1e-4,
+                "{u:?} -> {back:?}"
+            );
+        }
+    }
 
     #[test]
     fn uniform_weights_give_the_uniform_sphere_density() {
