@@ -62,3 +62,8 @@ pub use value::Value;
 
 /// The largest number of frozen-map epochs a batch may use.
 pub const MAX_EPOCHS: usize = epochs::MAX_EPOCHS;
+
+/// The README's host loop, compiled and run as a doc test so that it stays true.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeHostLoop;

@@ -2,7 +2,7 @@
 //! used for Russian roulette.
 //!
 //! `map_use = proposal` blends the same neighbourhood map as `map = neighbours`
-//! ([`super::neighbours`]) and holds it fixed, but rather than drawing candidates from the
+//! ([`ais::shared`]) and holds it fixed, but rather than drawing candidates from the
 //! strategy's density `p` and skipping those the map thinks blocked, it changes what is drawn,
 //! so every in-support candidate is traced and weighs `f / q`: nothing is paid for rejected
 //! candidates and stratified placement stays stratified.

@@ -1,4 +1,4 @@
-//! The learning pass of shared maps ([`super::Sharing::LearningPass`]): before a
+//! The learning pass of shared maps ([`super::settings::Sharing::LearningPass`]): before a
 //! tile is rendered, gathers at a coarse grid of points around it trace their rays with AIS
 //! off and keep what they saw; every gather of the tile then blends the learned maps near
 //! it (within `stride` pixel footprints), together with the tile's earlier gathers of
@@ -16,9 +16,11 @@
 //! (`T` = [`crate::render::TILE_SIZE`]), whatever the samples per pixel; the memory is one
 //! observation map per learning gather, per thread.
 
+use super::acceptance::Acceptance;
 use super::batch_loop::{run_batch, BatchRun};
 use super::guiding::CandidateSampler;
-use super::{gather_point, Acceptance, GatherSettings, MapSource, MapUse, Update};
+use super::settings::{GatherSettings, MapSource, MapUse, Update};
+use super::strategy::gather_point;
 use crate::render::{PixelRect, RayCounts, Tile};
 use crate::world::World;
 use ais::rng::{mix64, Pcg32};

@@ -21,10 +21,9 @@ pub use acceptance::Acceptance;
 pub use batch_loop::{run_batch, BatchProbe, BatchRun};
 pub use light::arriving_light;
 pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing, Update};
-pub use strategy::{GatherPoint, Strategy};
+pub use strategy::{gather_point, GatherPoint, Strategy};
 
-use crate::bsdf::ShadingFrame;
-use crate::geometry::{Hit, Ray};
+use crate::geometry::Ray;
 use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
 use ais::rng::Pcg32;
@@ -125,19 +124,6 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
             ais: self.ais_stats(),
             memory_per_thread: self.memory_bytes(),
         }
-    }
-}
-
-/// The gather point where `hit` is seen from direction `wo` (pointing away from it).
-pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a> {
-    let material = &world.materials[hit.shape as usize];
-    GatherPoint {
-        point: hit.point,
-        frame: ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo),
-        wo,
-        material,
-        lights: &world.lights,
-        environment_guide: None,
     }
 }
 

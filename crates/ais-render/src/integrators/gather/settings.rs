@@ -147,7 +147,7 @@ impl Preset {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Sharing {
     /// The gathers before it in its tile, in the tile's fixed pixel order (see
-    /// [`super::neighbours`]): free, but one-sided, and a tile's first gathers have none.
+    /// [`ais::shared`]): free, but one-sided, and a tile's first gathers have none.
     TileOrder,
     /// A learning pass: AIS-off gathers at the centres of `stride × stride` pixel blocks
     /// over the tile and one block around it, run before the tile (see

@@ -2,7 +2,9 @@
 //! a direction and the density of the whole strategy at that direction.
 
 use crate::bsdf::{Material, ShadingFrame};
+use crate::geometry::Hit;
 use crate::lights::{EnvironmentGuide, Lights};
+use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -62,6 +64,19 @@ pub struct GatherPoint<'a> {
     /// Light sampling draws the environment from its product with this batch's fixed
     /// affinity map (guided gathers), or from the environment alone (`None`).
     pub environment_guide: Option<&'a EnvironmentGuide>,
+}
+
+/// The gather point where `hit` is seen from direction `wo` (pointing away from it).
+pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a> {
+    let material = &world.materials[hit.shape as usize];
+    GatherPoint {
+        point: hit.point,
+        frame: ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo),
+        wo,
+        material,
+        lights: &world.lights,
+        environment_guide: None,
+    }
 }
 
 impl Strategy {
