@@ -32,6 +32,96 @@ pub struct World {
     pub warnings: Vec<String>,
 }
 
+/// One shape, ready for the BVH, and its area light if it emits.
+struct BuiltShape {
+    input: ShapeInput,
+    light: Option<AreaLight>,
+}
+
+/// A shape's material: its BSDF or, as in Mitsuba, diffuse 0.5 without one, or black when it
+/// emits (so that a light does not also reflect the other lights).
+fn shape_material(
+    description: &SceneDescription,
+    shape: &scene::ShapeDescription,
+    warnings: &mut Vec<String>,
+) -> Material {
+    match shape.bsdf {
+        Some(index) => {
+            Material::from_plugin(&description.bsdfs[index], &description.file, warnings)
+        }
+        None if shape.emitter.is_some() => Material::diffuse(Vec3::ZERO),
+        None => Material::default(),
+    }
+}
+
+/// Loads, transforms and validates shape number `index`, with its area light.
+fn build_shape(
+    file: &std::path::Path,
+    shape: &scene::ShapeDescription,
+    index: u32,
+    warnings: &mut Vec<String>,
+) -> Result<BuiltShape, InputError> {
+    let radiance = shape
+        .emitter
+        .as_ref()
+        .map(|e| radiance_property(file, e, "radiance"))
+        .transpose()?;
+    let mesh = match &shape.geometry {
+        scene::ShapeGeometry::Sphere { center, radius } => {
+            let geometry = shapes::sphere(file, shape.line, *center, *radius, shape.to_world)?;
+            let light = match (radiance, &geometry) {
+                (Some(radiance), ShapeGeometry::Sphere(sphere)) => Some(AreaLight {
+                    shape: AreaShape::Sphere {
+                        sphere: *sphere,
+                        flipped: shape.flip_normals,
+                    },
+                    radiance,
+                    shape_index: index,
+                }),
+                _ => None,
+            };
+            let input = ShapeInput {
+                geometry,
+                flip_normals: shape.flip_normals,
+            };
+            return Ok(BuiltShape { input, light });
+        }
+        scene::ShapeGeometry::Rectangle => shapes::rectangle(),
+        scene::ShapeGeometry::Disk => shapes::disk(),
+        scene::ShapeGeometry::Cube => shapes::cube(),
+        scene::ShapeGeometry::Mesh { path, format } => {
+            let loaded = load_mesh(path, *format)?;
+            warnings.extend(loaded.warnings);
+            loaded.mesh
+        }
+    };
+    let mesh = mesh.transformed(shape.to_world, shape.face_normals, shape.flip_normals);
+    // A transform can collapse triangles (e.g. a zero scale): validate again.
+    let checked = validate(file, mesh).map_err(|e| {
+        InputError::at(
+            file,
+            shape.line,
+            format!("shape became unusable after to_world: {}", e.message),
+        )
+    })?;
+    warnings.extend(checked.warnings);
+    let light = radiance.map(|radiance| {
+        let is_rectangle = shape.geometry == scene::ShapeGeometry::Rectangle;
+        area_light(
+            &checked.mesh,
+            is_rectangle,
+            shape.flip_normals,
+            radiance,
+            index,
+        )
+    });
+    let input = ShapeInput {
+        geometry: ShapeGeometry::Mesh(checked.mesh),
+        flip_normals: shape.flip_normals,
+    };
+    Ok(BuiltShape { input, light })
+}
+
 impl World {
     /// Loads meshes, applies transforms and builds the BVH.
     pub fn from_description(description: SceneDescription) -> Result<Self, InputError> {
@@ -40,74 +130,11 @@ impl World {
         let mut inputs = Vec::with_capacity(description.shapes.len());
         let mut area_lights = Vec::new();
         let mut materials = Vec::with_capacity(description.shapes.len());
-        for (shape_index, shape) in description.shapes.iter().enumerate() {
-            materials.push(match shape.bsdf {
-                Some(index) => {
-                    Material::from_plugin(&description.bsdfs[index], &file, &mut warnings)
-                }
-                // As in Mitsuba: a shape without a BSDF is diffuse 0.5, or black when it
-                // emits (so that a light does not also reflect the other lights).
-                None if shape.emitter.is_some() => Material::diffuse(Vec3::ZERO),
-                None => Material::default(),
-            });
-            let radiance = shape
-                .emitter
-                .as_ref()
-                .map(|e| radiance_property(&file, e, "radiance"))
-                .transpose()?;
-            let mesh = match &shape.geometry {
-                scene::ShapeGeometry::Sphere { center, radius } => {
-                    let geometry =
-                        shapes::sphere(&file, shape.line, *center, *radius, shape.to_world)?;
-                    if let (Some(radiance), ShapeGeometry::Sphere(sphere)) = (radiance, &geometry) {
-                        area_lights.push(AreaLight {
-                            shape: AreaShape::Sphere {
-                                sphere: *sphere,
-                                flipped: shape.flip_normals,
-                            },
-                            radiance,
-                            shape_index: shape_index as u32,
-                        });
-                    }
-                    inputs.push(ShapeInput {
-                        geometry,
-                        flip_normals: shape.flip_normals,
-                    });
-                    continue;
-                }
-                scene::ShapeGeometry::Rectangle => shapes::rectangle(),
-                scene::ShapeGeometry::Disk => shapes::disk(),
-                scene::ShapeGeometry::Cube => shapes::cube(),
-                scene::ShapeGeometry::Mesh { path, format } => {
-                    let loaded = load_mesh(path, *format)?;
-                    warnings.extend(loaded.warnings);
-                    loaded.mesh
-                }
-            };
-            let mesh = mesh.transformed(shape.to_world, shape.face_normals, shape.flip_normals);
-            // A transform can collapse triangles (e.g. a zero scale): validate again.
-            let checked = validate(&file, mesh).map_err(|e| {
-                InputError::at(
-                    &file,
-                    shape.line,
-                    format!("shape became unusable after to_world: {}", e.message),
-                )
-            })?;
-            warnings.extend(checked.warnings);
-            if let Some(radiance) = radiance {
-                let is_rectangle = shape.geometry == scene::ShapeGeometry::Rectangle;
-                area_lights.push(area_light(
-                    &checked.mesh,
-                    is_rectangle,
-                    shape.flip_normals,
-                    radiance,
-                    shape_index as u32,
-                ));
-            }
-            inputs.push(ShapeInput {
-                geometry: ShapeGeometry::Mesh(checked.mesh),
-                flip_normals: shape.flip_normals,
-            });
+        for (index, shape) in description.shapes.iter().enumerate() {
+            materials.push(shape_material(&description, shape, &mut warnings));
+            let built = build_shape(&file, shape, index as u32, &mut warnings)?;
+            inputs.push(built.input);
+            area_lights.extend(built.light);
         }
         let geometry = Geometry::build(inputs);
         let environment = match description.emitters.as_slice() {

@@ -3,6 +3,7 @@
 
 mod conductors;
 mod microfacet;
+mod reader;
 mod rough_plastic;
 
 pub use conductors::named_conductor;
@@ -10,7 +11,7 @@ pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, Microfac
 pub use rough_plastic::RoughPlastic;
 
 use crate::geometry::basis;
-use crate::scene::{Plugin, Property};
+use crate::scene::Plugin;
 use ais::sampling::cosine_hemisphere;
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -104,76 +105,6 @@ impl ShadingFrame {
     }
 }
 
-fn rgb(plugin: &Plugin, name: &str, default: Vec3) -> Result<Vec3, String> {
-    match plugin.properties.get(name).map(|p| &p.value) {
-        None => Ok(default),
-        Some(Property::Rgb(c)) => Ok(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)),
-        Some(Property::Float(v)) => Ok(Vec3::splat(*v as f32)),
-        Some(other) => Err(format!(
-            "\"{name}\" must be an rgb or float, not a {}",
-            other.kind()
-        )),
-    }
-}
-
-/// An index of refraction given as a number or by name (the names Mitsuba accepts).
-fn index_of_refraction(
-    plugin: &Plugin,
-    name: &str,
-    default: f64,
-    warn: &mut dyn FnMut(String),
-) -> f64 {
-    match plugin.properties.get(name).map(|p| &p.value) {
-        None => default,
-        Some(Property::Float(v)) if *v > 0.0 => *v,
-        Some(Property::String(material)) => match named_index_of_refraction(material) {
-            Some(v) => v,
-            None => {
-                warn(format!(
-                    "\"{name}\": unknown material \"{material}\"; using {default}"
-                ));
-                default
-            }
-        },
-        Some(other) => {
-            warn(format!(
-                "\"{name}\" must be a positive float or a material name, not {other:?}; using {default}"
-            ));
-            default
-        }
-    }
-}
-
-/// Indices of refraction of common dielectrics at about 589 nm.
-fn named_index_of_refraction(material: &str) -> Option<f64> {
-    Some(match material.to_ascii_lowercase().as_str() {
-        "vacuum" => 1.0,
-        "helium" => 1.00004,
-        "hydrogen" => 1.00013,
-        "air" => 1.000277,
-        "carbon dioxide" => 1.00045,
-        "water" => 1.333,
-        "acetone" => 1.36,
-        "ethanol" => 1.361,
-        "carbon tetrachloride" => 1.461,
-        "glycerol" => 1.4729,
-        "benzene" => 1.501,
-        "silicone oil" => 1.52045,
-        "bromine" => 1.661,
-        "water ice" => 1.31,
-        "fused quartz" => 1.458,
-        "pyrex" => 1.47,
-        "acrylic glass" => 1.49,
-        "polypropylene" => 1.49,
-        "bk7" => 1.5046,
-        "sodium chloride" => 1.544,
-        "amber" => 1.55,
-        "pet" => 1.575,
-        "diamond" => 2.419,
-        _ => return None,
-    })
-}
-
 impl Material {
     /// One-sided diffuse of albedo `reflectance`.
     pub fn diffuse(reflectance: Vec3) -> Self {
@@ -190,148 +121,12 @@ impl Material {
         file: &std::path::Path,
         warnings: &mut Vec<String>,
     ) -> Material {
-        let mut warn = |message: String| {
-            warnings.push(format!("{}:{}: {message}", file.display(), plugin.line))
-        };
-        let microfacet = |warn: &mut dyn FnMut(String)| -> Microfacet {
-            if plugin.properties.contains_key("alpha_u")
-                || plugin.properties.contains_key("alpha_v")
-            {
-                warn("anisotropic alpha_u/alpha_v are not supported; using alpha".into());
-            }
-            // Mitsuba's default distribution is Beckmann.
-            let kind = match plugin.string("distribution") {
-                Ok(None) => MicrofacetKind::Beckmann,
-                Ok(Some(d)) if d.eq_ignore_ascii_case("beckmann") => MicrofacetKind::Beckmann,
-                Ok(Some(d)) if d.eq_ignore_ascii_case("ggx") => MicrofacetKind::Ggx,
-                Ok(Some(d)) => {
-                    warn(format!(
-                        "microfacet distribution \"{d}\" is not beckmann or ggx; using beckmann"
-                    ));
-                    MicrofacetKind::Beckmann
-                }
-                Err((_, message)) => {
-                    warn(message);
-                    MicrofacetKind::Beckmann
-                }
-            };
-            Microfacet::new(kind, plugin.float("alpha", 0.1).unwrap_or(0.1) as f32)
-        };
-        let checked = |value: Result<Vec3, String>, warn: &mut dyn FnMut(String), default: Vec3| {
-            match value {
-                Ok(v) if v.is_finite() && v.min_element() >= 0.0 => v,
-                Ok(_) => {
-                    warn("a colour is negative or not finite; using the default".into());
-                    default
-                }
-                Err(message) => {
-                    warn(format!("{message}; using the default"));
-                    default
-                }
-            }
-        };
-        match plugin.kind.as_str() {
-            "diffuse" => {
-                let reflectance = checked(
-                    rgb(plugin, "reflectance", Vec3::splat(0.5)),
-                    &mut warn,
-                    Vec3::splat(0.5),
-                );
-                Material::diffuse(reflectance.min(Vec3::ONE))
-            }
-            "roughconductor" => {
-                let microfacet = microfacet(&mut warn);
-                let (eta, k) = if plugin.properties.contains_key("eta")
-                    || plugin.properties.contains_key("k")
-                {
-                    (
-                        checked(rgb(plugin, "eta", Vec3::ZERO), &mut warn, Vec3::ZERO),
-                        checked(rgb(plugin, "k", Vec3::ONE), &mut warn, Vec3::ONE),
-                    )
-                } else {
-                    match plugin.string("material") {
-                        Ok(None) | Ok(Some("none")) => (Vec3::ZERO, Vec3::ZERO),
-                        Ok(Some(name)) => match named_conductor(name) {
-                            Some(ior) => ior,
-                            None => {
-                                warn(format!("conductor \"{name}\" is not in ais's table; using a perfect mirror (material \"none\")"));
-                                (Vec3::ZERO, Vec3::ZERO)
-                            }
-                        },
-                        Err((_, message)) => {
-                            warn(message);
-                            (Vec3::ZERO, Vec3::ZERO)
-                        }
-                    }
-                };
-                let specular = checked(
-                    rgb(plugin, "specular_reflectance", Vec3::ONE),
-                    &mut warn,
-                    Vec3::ONE,
-                );
-                Material {
-                    scattering: Scattering::RoughConductor {
-                        microfacet,
-                        eta,
-                        k,
-                        specular,
-                    },
-                    two_sided: false,
-                }
-            }
-            "roughplastic" => {
-                let microfacet = microfacet(&mut warn);
-                let int_ior = index_of_refraction(plugin, "int_ior", 1.49, &mut warn);
-                let ext_ior = index_of_refraction(plugin, "ext_ior", 1.000277, &mut warn);
-                let diffuse = checked(
-                    rgb(plugin, "diffuse_reflectance", Vec3::splat(0.5)),
-                    &mut warn,
-                    Vec3::splat(0.5),
-                );
-                let specular = checked(
-                    rgb(plugin, "specular_reflectance", Vec3::ONE),
-                    &mut warn,
-                    Vec3::ONE,
-                );
-                let nonlinear = plugin.boolean("nonlinear", false).unwrap_or(false);
-                let eta = (int_ior / ext_ior) as f32;
-                let eta = if eta.is_finite() && eta > 0.0 && eta != 1.0 {
-                    eta
-                } else {
-                    warn(format!(
-                        "int_ior / ext_ior = {eta} must be positive and not 1; using 1.49"
-                    ));
-                    1.49
-                };
-                Material {
-                    scattering: Scattering::RoughPlastic(RoughPlastic::new(
-                        microfacet,
-                        eta,
-                        diffuse.min(Vec3::ONE),
-                        specular,
-                        nonlinear,
-                    )),
-                    two_sided: false,
-                }
-            }
-            "twosided" => {
-                let inner = plugin
-                    .children
-                    .first()
-                    .map(|c| Material::from_plugin(c, file, warnings))
-                    .unwrap_or_default();
-                Material {
-                    two_sided: true,
-                    ..inner
-                }
-            }
-            other => {
-                warn(format!(
-                    "bsdf \"{other}\" is not implemented; rendered as diffuse 0.5"
-                ));
-                Material::default()
-            }
+        reader::BsdfReader {
+            plugin,
+            file,
+            warnings,
         }
+        .material()
     }
 
     /// Whether `wi` can carry light to `wo`: both on the front side of the shading and

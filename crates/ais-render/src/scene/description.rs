@@ -127,7 +127,6 @@ pub fn parse_scene(
     overrides: &[(String, String)],
 ) -> Result<SceneDescription, InputError> {
     let parsed = xml::parse(path, text, overrides)?;
-    let at = |(line, message): (u32, String)| InputError::at(path, line, message);
     let mut scene = SceneDescription {
         file: path.to_path_buf(),
         camera: CameraDescription {
@@ -144,7 +143,6 @@ pub fn parse_scene(
         warnings: parsed.warnings,
     };
     let folder = path.parent().unwrap_or(Path::new("."));
-    let mut sensor_seen = false;
     // BSDFs first so that shapes may reference ones declared after them.
     for plugin in parsed.plugins.iter().filter(|p| p.tag == "bsdf") {
         if plugin.id.is_none() {
@@ -156,43 +154,19 @@ pub fn parse_scene(
         }
         scene.bsdfs.push(plugin.clone());
     }
+    let mut sensor_seen = false;
     for plugin in &parsed.plugins {
-        match plugin.tag.as_str() {
-            "bsdf" | "texture" => {}
-            "sensor" => {
-                if sensor_seen {
-                    return Err(InputError::at(
-                        path,
-                        plugin.line,
-                        "only one <sensor> is supported",
-                    ));
-                }
-                sensor_seen = true;
-                read_sensor(path, plugin, &mut scene).map_err(at)?;
-            }
-            "shape" => {
-                let shape = read_shape(path, folder, plugin, &mut scene).map_err(at)?;
-                scene.shapes.push(shape);
-            }
-            "emitter" => {
-                if plugin.kind == "area" {
-                    return Err(InputError::at(
-                        path,
-                        plugin.line,
-                        "an area emitter must be nested in a <shape>",
-                    ));
-                }
-                scene.emitters.push(plugin.clone());
-            }
-            "integrator" => scene.integrator = Some(plugin.clone()),
-            other => {
+        if plugin.tag == "sensor" {
+            if sensor_seen {
                 return Err(InputError::at(
                     path,
                     plugin.line,
-                    format!("<{other}> is not allowed at scene level"),
-                ))
+                    "only one <sensor> is supported",
+                ));
             }
+            sensor_seen = true;
         }
+        read_top_level(path, folder, plugin, &mut scene)?;
     }
     if !sensor_seen {
         scene.warnings.push(format!(
@@ -203,11 +177,72 @@ pub fn parse_scene(
     Ok(scene)
 }
 
+/// One top-level element other than a BSDF (read before the rest).
+fn read_top_level(
+    path: &Path,
+    folder: &Path,
+    plugin: &Plugin,
+    scene: &mut SceneDescription,
+) -> Result<(), InputError> {
+    let at = |(line, message): (u32, String)| InputError::at(path, line, message);
+    match plugin.tag.as_str() {
+        "bsdf" | "texture" => {}
+        "sensor" => read_sensor(path, plugin, scene).map_err(at)?,
+        "shape" => {
+            let shape = read_shape(path, folder, plugin, scene).map_err(at)?;
+            scene.shapes.push(shape);
+        }
+        "emitter" if plugin.kind == "area" => {
+            return Err(InputError::at(
+                path,
+                plugin.line,
+                "an area emitter must be nested in a <shape>",
+            ))
+        }
+        "emitter" => scene.emitters.push(plugin.clone()),
+        "integrator" => scene.integrator = Some(plugin.clone()),
+        other => {
+            return Err(InputError::at(
+                path,
+                plugin.line,
+                format!("<{other}> is not allowed at scene level"),
+            ))
+        }
+    }
+    Ok(())
+}
+
 fn read_sensor(
     path: &Path,
     sensor: &Plugin,
     scene: &mut SceneDescription,
 ) -> Result<(), (u32, String)> {
+    scene.camera = read_camera(path, sensor, &mut scene.warnings)?;
+    for child in &sensor.children {
+        match child.tag.as_str() {
+            "film" => scene.resolution = read_film(path, child, &mut scene.warnings)?,
+            "sampler" => {
+                let count = child.integer("sample_count", 4)?;
+                if count < 1 {
+                    return Err((
+                        child.line,
+                        format!("sample_count must be at least 1, got {count}"),
+                    ));
+                }
+                scene.sample_count = count as u32;
+            }
+            other => return Err((child.line, format!("<{other}> is not allowed in a sensor"))),
+        }
+    }
+    Ok(())
+}
+
+/// The camera of a `perspective` (or, as a pinhole, `thinlens`) sensor.
+fn read_camera(
+    path: &Path,
+    sensor: &Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<CameraDescription, (u32, String)> {
     if sensor.kind != "perspective" && sensor.kind != "thinlens" {
         return Err((
             sensor.line,
@@ -218,7 +253,7 @@ fn read_sensor(
         ));
     }
     if sensor.kind == "thinlens" {
-        scene.warnings.push(format!(
+        warnings.push(format!(
             "{}:{}: thinlens sensor rendered as a pinhole (perspective)",
             path.display(),
             sensor.line
@@ -239,85 +274,66 @@ fn read_sensor(
         "larger" => FovAxis::Larger,
         other => return Err((sensor.line, format!("unknown fov_axis \"{other}\""))),
     };
-    scene.camera = CameraDescription {
+    let camera = CameraDescription {
         to_world: sensor.transform("to_world")?,
         fov_degrees: fov,
         fov_axis,
     };
-    warn_unknown(
-        path,
-        sensor,
-        &[
-            "fov",
-            "fov_axis",
-            "to_world",
-            "near_clip",
-            "far_clip",
-            "focus_distance",
-            "aperture_radius",
-            "focal_length",
-        ],
-        &mut scene.warnings,
-    );
-    for child in &sensor.children {
-        match child.tag.as_str() {
-            "film" => {
-                if child.kind != "hdrfilm" {
-                    return Err((
-                        child.line,
-                        format!(
-                            "film type \"{}\" is not supported (use hdrfilm)",
-                            child.kind
-                        ),
-                    ));
-                }
-                let width = child.integer("width", 768)?;
-                let height = child.integer("height", 576)?;
-                if !(1..=65536).contains(&width) || !(1..=65536).contains(&height) {
-                    return Err((
-                        child.line,
-                        format!("film size {width}×{height} is out of range"),
-                    ));
-                }
-                scene.resolution = (width as u32, height as u32);
-                warn_unknown(
-                    path,
-                    child,
-                    &[
-                        "width",
-                        "height",
-                        "pixel_format",
-                        "component_format",
-                        "file_format",
-                        "rfilter",
-                    ],
-                    &mut scene.warnings,
-                );
-                for filter in &child.children {
-                    if filter.kind != "box" {
-                        scene.warnings.push(format!(
-                            "{}:{}: reconstruction filter \"{}\" replaced by a box filter",
-                            path.display(),
-                            filter.line,
-                            filter.kind
-                        ));
-                    }
-                }
-            }
-            "sampler" => {
-                let count = child.integer("sample_count", 4)?;
-                if count < 1 {
-                    return Err((
-                        child.line,
-                        format!("sample_count must be at least 1, got {count}"),
-                    ));
-                }
-                scene.sample_count = count as u32;
-            }
-            other => return Err((child.line, format!("<{other}> is not allowed in a sensor"))),
+    const KNOWN: [&str; 8] = [
+        "fov",
+        "fov_axis",
+        "to_world",
+        "near_clip",
+        "far_clip",
+        "focus_distance",
+        "aperture_radius",
+        "focal_length",
+    ];
+    warn_unknown(path, sensor, &KNOWN, warnings);
+    Ok(camera)
+}
+
+/// The size of an `hdrfilm`; its reconstruction filter is replaced by a box (with a
+/// warning for any other).
+fn read_film(
+    path: &Path,
+    film: &Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<(u32, u32), (u32, String)> {
+    if film.kind != "hdrfilm" {
+        return Err((
+            film.line,
+            format!("film type \"{}\" is not supported (use hdrfilm)", film.kind),
+        ));
+    }
+    let width = film.integer("width", 768)?;
+    let height = film.integer("height", 576)?;
+    if !(1..=65536).contains(&width) || !(1..=65536).contains(&height) {
+        return Err((
+            film.line,
+            format!("film size {width}×{height} is out of range"),
+        ));
+    }
+    const KNOWN: [&str; 6] = [
+        "width",
+        "height",
+        "pixel_format",
+        "component_format",
+        "file_format",
+        "rfilter",
+    ];
+    warn_unknown(path, film, &KNOWN, warnings);
+    for filter in &film.children {
+        if filter.kind != "box" {
+            warnings.push(format!(
+                "{}:{}: reconstruction filter \"{}\" replaced by a box filter",
+                path.display(),
+                filter.line,
+                filter.kind
+            ));
         }
     }
-    Ok(())
+    Ok((width as u32, height as u32))
 }
 
 fn read_shape(
@@ -326,6 +342,25 @@ fn read_shape(
     shape: &Plugin,
     scene: &mut SceneDescription,
 ) -> Result<ShapeDescription, (u32, String)> {
+    let (geometry, known) = shape_geometry(folder, shape)?;
+    warn_unknown(path, shape, known, &mut scene.warnings);
+    let attached = attachments(shape, scene)?;
+    Ok(ShapeDescription {
+        geometry,
+        to_world: shape.transform("to_world")?,
+        flip_normals: shape.boolean("flip_normals", false)?,
+        face_normals: shape.boolean("face_normals", false)?,
+        bsdf: attached.bsdf,
+        emitter: attached.emitter,
+        line: shape.line,
+    })
+}
+
+/// A shape's geometry and the property names its type knows.
+fn shape_geometry(
+    folder: &Path,
+    shape: &Plugin,
+) -> Result<(ShapeGeometry, &'static [&'static str]), (u32, String)> {
     let mesh = |format: MeshFormat| -> Result<ShapeGeometry, (u32, String)> {
         let name = shape.string("filename")?.ok_or((
             shape.line,
@@ -336,7 +371,7 @@ fn read_shape(
             format,
         })
     };
-    let (geometry, known): (ShapeGeometry, &[&str]) = match shape.kind.as_str() {
+    Ok(match shape.kind.as_str() {
         "sphere" => {
             let radius = shape.float("radius", 1.0)?;
             if !(radius > 0.0 && radius.is_finite()) {
@@ -357,17 +392,28 @@ fn read_shape(
         "ply" => (mesh(MeshFormat::Ply)?, &["filename", "to_world", "flip_normals", "face_normals"]),
         "glb" | "gltf" => (mesh(MeshFormat::Glb)?, &["filename", "to_world", "flip_normals", "face_normals"]),
         other => return Err((shape.line, format!("shape type \"{other}\" is not supported (obj, ply, glb, sphere, rectangle, disk, cube)"))),
+    })
+}
+
+/// What a shape carries: its BSDF (an index into the scene's BSDFs) and area emitter.
+struct Attachments {
+    bsdf: Option<usize>,
+    emitter: Option<Plugin>,
+}
+
+/// A shape's BSDF (referenced or nested; nested ones join the scene's list) and emitter.
+fn attachments(shape: &Plugin, scene: &mut SceneDescription) -> Result<Attachments, (u32, String)> {
+    let mut attached = Attachments {
+        bsdf: None,
+        emitter: None,
     };
-    warn_unknown(path, shape, known, &mut scene.warnings);
-    let mut bsdf = None;
-    let mut emitter = None;
     for (_, id, line) in &shape.references {
         let index = scene
             .bsdfs
             .iter()
             .position(|b| b.id.as_deref() == Some(id.as_str()))
             .ok_or((*line, format!("no <bsdf> with id \"{id}\"")))?;
-        if bsdf.replace(index).is_some() {
+        if attached.bsdf.replace(index).is_some() {
             return Err((*line, "a shape can have only one bsdf".into()));
         }
     }
@@ -375,34 +421,24 @@ fn read_shape(
         match child.tag.as_str() {
             "bsdf" => {
                 scene.bsdfs.push(child.clone());
-                if bsdf.replace(scene.bsdfs.len() - 1).is_some() {
+                if attached.bsdf.replace(scene.bsdfs.len() - 1).is_some() {
                     return Err((child.line, "a shape can have only one bsdf".into()));
                 }
             }
+            "emitter" if child.kind == "area" => attached.emitter = Some(child.clone()),
             "emitter" => {
-                if child.kind != "area" {
-                    return Err((
-                        child.line,
-                        format!(
-                            "a shape can only carry an area emitter, not \"{}\"",
-                            child.kind
-                        ),
-                    ));
-                }
-                emitter = Some(child.clone());
+                return Err((
+                    child.line,
+                    format!(
+                        "a shape can only carry an area emitter, not \"{}\"",
+                        child.kind
+                    ),
+                ))
             }
             other => return Err((child.line, format!("<{other}> is not allowed in a shape"))),
         }
     }
-    Ok(ShapeDescription {
-        geometry,
-        to_world: shape.transform("to_world")?,
-        flip_normals: shape.boolean("flip_normals", false)?,
-        face_normals: shape.boolean("face_normals", false)?,
-        bsdf,
-        emitter,
-        line: shape.line,
-    })
+    Ok(attached)
 }
 
 fn warn_unknown(path: &Path, plugin: &Plugin, known: &[&str], warnings: &mut Vec<String>) {

@@ -171,21 +171,19 @@ fn figure_canvas(name: &str, caption: &str) -> String {
     )
 }
 
-/// The whole report as HTML.
-pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, String> {
-    let (width, height) = (
-        results.reference.image.width,
-        results.reference.image.height,
-    );
-    fn seed0(result: &ConfigurationResult) -> &RgbImage {
-        result
-            .equal_time
-            .first()
-            .or(result.equal_rays.first())
-            .map(|r| &r.image)
-            .expect("every configuration has runs")
-    }
-    // Embedded HDR images: the reference and each configuration's first run.
+/// A configuration's first run (equal time if it has one): the one its images show.
+fn seed0(result: &ConfigurationResult) -> &RgbImage {
+    result
+        .equal_time
+        .first()
+        .or(result.equal_rays.first())
+        .map(|r| &r.image)
+        .expect("every configuration has runs")
+}
+
+/// The embedded HDR images, as a JavaScript object: the reference and each configuration's
+/// first run.
+fn embedded_images(results: &StudyResults) -> String {
     let mut images = String::from("{");
     let mut embed = |name: &str, image: &RgbImage| {
         let _ = write!(
@@ -202,7 +200,11 @@ pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, S
         embed(&result.configuration.name, seed0(result));
     }
     images.push('}');
+    images
+}
 
+/// The viewer's image choices.
+fn image_options(results: &StudyResults) -> String {
     let mut options = String::from(r#"<option value="reference">reference</option>"#);
     for result in &results.results {
         let _ = write!(
@@ -211,7 +213,15 @@ pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, S
             escape(&result.configuration.name)
         );
     }
+    options
+}
 
+/// A false-colour relative-error image per configuration.
+fn error_maps(results: &StudyResults) -> Result<String, String> {
+    let (width, height) = (
+        results.reference.image.width,
+        results.reference.image.height,
+    );
     let mut errors = String::new();
     for result in &results.results {
         let url = png_data_url(
@@ -230,7 +240,11 @@ pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, S
             escape(&result.configuration.name)
         );
     }
+    Ok(errors)
+}
 
+/// The log-log plots of relMSE against time and against rays.
+fn convergence_plots(results: &StudyResults) -> Result<(String, String), String> {
     let curves = |pick: &dyn Fn(&ConfigurationResult) -> &[Run],
                   x: &dyn Fn(&super::CurvePoint) -> f64| {
         results
@@ -257,21 +271,26 @@ pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, S
         &curves(&|r| &r.equal_rays, &|p| p.rays as f64),
         (640, 400),
     )?;
+    Ok((time_plot, rays_plot))
+}
 
-    let find = |name: &str| {
-        results
-            .results
-            .iter()
-            .find(|r| r.configuration.name == name)
-    };
-    let group = |names: &[&str]| {
-        names
-            .iter()
-            .filter_map(|name| find(name))
-            .map(|r| figure_canvas(&r.configuration.name, &r.configuration.label))
-            .collect::<String>()
-    };
-    let maps = match &results.figure {
+/// The canvases of the named configurations that the study ran, in order.
+fn figure_group(results: &StudyResults, names: &[&str]) -> String {
+    names
+        .iter()
+        .filter_map(|name| {
+            results
+                .results
+                .iter()
+                .find(|r| r.configuration.name == *name)
+        })
+        .map(|r| figure_canvas(&r.configuration.name, &r.configuration.label))
+        .collect()
+}
+
+/// The affinity-map figure: the pixel's map after each snapshot's rays.
+fn affinity_maps(results: &StudyResults) -> String {
+    match &results.figure {
         Some(snapshots) => snapshots
             .iter()
             .zip(SNAPSHOTS)
@@ -281,12 +300,34 @@ pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, S
                     snapshot_svg(s, 24)
                 )
             })
-            .collect::<String>(),
+            .collect(),
         None => "<p>The chosen pixel sees no gather point.</p>".into(),
-    };
+    }
+}
 
-    let tables = markdown_to_html_tables(&markdown_tables(results, context));
+/// The reference's provenance and noise, for the report's text.
+fn reference_note(results: &StudyResults) -> String {
+    format!(
+        "{}; its own noise would add {:.2e} to every relMSE, which is subtracted",
+        if results.reference.cached {
+            " (from the cache)"
+        } else {
+            ""
+        },
+        results.reference.noise_floor()
+    )
+}
+
+/// The whole report as HTML.
+pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, String> {
+    let (time_plot, rays_plot) = convergence_plots(results)?;
     let (x, y) = context.figure_pixel;
+    let placement = [
+        "mis-off",
+        "mis-off-random",
+        "mis-aggressive",
+        "mis-aggressive-random",
+    ];
     let substitutions: [(&str, String); 20] = [
         ("SCENE", escape(context.scene)),
         ("WIDTH", context.resolution.0.to_string()),
@@ -295,44 +336,28 @@ pub fn html(results: &StudyResults, context: &ReportContext) -> Result<String, S
         ("BUDGET", format!("{:.1}", context.time_budget)),
         ("SEEDS", context.seeds.to_string()),
         ("REFERENCE_SPP", context.reference_spp.to_string()),
-        (
-            "REFERENCE_CACHED",
-            format!(
-                "{}; its own noise would add {:.2e} to every relMSE, which is subtracted",
-                if results.reference.cached {
-                    " (from the cache)"
-                } else {
-                    ""
-                },
-                results.reference.noise_floor()
-            ),
-        ),
+        ("REFERENCE_CACHED", reference_note(results)),
         ("THREADS", context.threads.to_string()),
-        ("OPTIONS", options),
-        ("ERRORS", errors),
+        ("OPTIONS", image_options(results)),
+        ("ERRORS", error_maps(results)?),
         ("TIME_PLOT", time_plot),
         ("RAYS_PLOT", rays_plot),
         (
             "FIGURE_UNIFORM",
-            group(&["uniform-off", "mis-off", "mis-aggressive"]),
+            figure_group(results, &["uniform-off", "mis-off", "mis-aggressive"]),
         ),
         (
             "FIGURE_MODES",
-            group(&["mis-off", "mis-aggressive", "mis-conservative"]),
+            figure_group(results, &["mis-off", "mis-aggressive", "mis-conservative"]),
         ),
-        (
-            "FIGURE_PLACEMENT",
-            group(&[
-                "mis-off",
-                "mis-off-random",
-                "mis-aggressive",
-                "mis-aggressive-random",
-            ]),
-        ),
-        ("MAPS", maps),
+        ("FIGURE_PLACEMENT", figure_group(results, &placement)),
+        ("MAPS", affinity_maps(results)),
         ("PIXEL", format!("({x}, {y})")),
-        ("TABLES", tables),
-        ("IMAGES", images),
+        (
+            "TABLES",
+            markdown_to_html_tables(&markdown_tables(results, context)),
+        ),
+        ("IMAGES", embedded_images(results)),
     ];
     // Markers are replaced in this order; none of the inserted texts contains a later marker.
     let mut html = include_str!("report_template.html").to_string();

@@ -28,7 +28,7 @@ use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
 use ais::rng::Pcg32;
 use ais::shared::{blend_neighbours, NeighbourSource, RecentGathers};
-use ais::{Batch, MapStart};
+use ais::{AffinityMap, Batch, MapStart};
 use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
@@ -127,6 +127,60 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
     }
 }
 
+/// Where a gather's neighbours' maps come from.
+struct Neighbourhood<'a> {
+    /// The tile's recent gathers.
+    recent: &'a RecentGathers,
+    /// The tile's learning pass.
+    learned: &'a LearningPass,
+    /// Which of the two to use.
+    sharing: Sharing,
+    /// The pixel footprint at the gather point, in world units.
+    footprint: f32,
+}
+
+impl Neighbourhood<'_> {
+    /// Sets `map` to the blend of the neighbours near `point` (shading normal `normal`);
+    /// returns how many contributed.
+    fn blend_into(&self, map: &mut AffinityMap, point: Vec3, normal: Vec3) -> usize {
+        let recent = NeighbourSource {
+            neighbours: self.recent.neighbours(),
+            radius: RADIUS_PIXELS * self.footprint,
+        };
+        match self.sharing {
+            Sharing::TileOrder => blend_neighbours(map, &[recent], point, normal),
+            // The pass gives neighbours on all sides; the tile's earlier gathers add theirs.
+            Sharing::LearningPass { stride } => {
+                let learned = NeighbourSource {
+                    neighbours: self.learned.neighbours(),
+                    radius: stride as f32 * self.footprint,
+                };
+                blend_neighbours(map, &[recent, learned], point, normal)
+            }
+        }
+    }
+}
+
+/// The candidate sampler of a gather at `at` whose fixed map is folded into the proposal:
+/// light sampling through the environment's product with the map, or a mixture.
+fn guided_sampler<'g>(
+    guide: &'g mut Guide,
+    map: &AffinityMap,
+    settings: &GatherSettings,
+    at: &mut GatherPoint<'g>,
+) -> CandidateSampler<'g> {
+    match guide.prepare(map, settings.strategy, at, settings.guide_fraction) {
+        Guidance::Unguided => CandidateSampler::plain(settings.strategy),
+        Guidance::Environment(environment) => {
+            at.environment_guide = Some(environment);
+            CandidateSampler::plain(settings.strategy)
+        }
+        Guidance::Mixture(distribution) => {
+            CandidateSampler::guided(settings.strategy, distribution, settings.guide_fraction)
+        }
+    }
+}
+
 /// The gather: emitted radiance at the first hit of `ray` plus `n` rays of direct light
 /// through the AIS batch driver.
 pub fn gather<P: BatchProbe>(
@@ -158,38 +212,18 @@ pub fn gather<P: BatchProbe>(
     let mut sampler = CandidateSampler::plain(settings.strategy);
     let start = if sharing {
         let map = batch.map_mut().expect("shared maps have a map");
-        let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
-        let recent = NeighbourSource {
-            neighbours: state.recent.neighbours(),
-            radius: RADIUS_PIXELS * footprint,
+        let neighbourhood = Neighbourhood {
+            recent: &state.recent,
+            learned: &state.learned,
+            sharing: settings.sharing,
+            footprint: hit.t * world.camera.pixel_angle(world.resolution.0),
         };
-        let (point, normal) = (hit.point, at.frame.normal);
-        let found = match settings.sharing {
-            Sharing::TileOrder => blend_neighbours(map, &[recent], point, normal),
-            // The pass gives neighbours on all sides; the tile's earlier gathers add theirs.
-            Sharing::LearningPass { stride } => {
-                let learned = NeighbourSource {
-                    neighbours: state.learned.neighbours(),
-                    radius: stride as f32 * footprint,
-                };
-                blend_neighbours(map, &[recent, learned], point, normal)
-            }
-        };
+        let found = neighbourhood.blend_into(map, hit.point, at.frame.normal);
         if settings.map_use == MapUse::Proposal && found > 0 {
             let guide = state
                 .guide
                 .get_or_insert_with(|| Guide::new(settings.map_height));
-            match guide.prepare(map, settings.strategy, &at, settings.guide_fraction) {
-                Guidance::Unguided => {}
-                Guidance::Environment(environment) => at.environment_guide = Some(environment),
-                Guidance::Mixture(distribution) => {
-                    sampler = CandidateSampler::guided(
-                        settings.strategy,
-                        distribution,
-                        settings.guide_fraction,
-                    )
-                }
-            }
+            sampler = guided_sampler(guide, map, settings, &mut at);
         }
         MapStart::Current
     } else {

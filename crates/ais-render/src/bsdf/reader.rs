@@ -1,0 +1,229 @@
+//! Reading a Mitsuba `<bsdf>` into a [`Material`]: every parameter checked, and anything
+//! unsupported replaced by the closest supported value with a warning naming the file and
+//! line.
+
+use super::{named_conductor, Material, Microfacet, MicrofacetKind, RoughPlastic, Scattering};
+use crate::scene::{Plugin, Property};
+use glam::Vec3;
+
+/// A `<bsdf>` being read, and where its warnings go.
+pub(super) struct BsdfReader<'a> {
+    /// The element.
+    pub plugin: &'a Plugin,
+    /// The scene file, for warnings.
+    pub file: &'a std::path::Path,
+    /// Warnings so far.
+    pub warnings: &'a mut Vec<String>,
+}
+
+/// A colour property given as rgb or a float, or `default`.
+fn rgb(plugin: &Plugin, name: &str, default: Vec3) -> Result<Vec3, String> {
+    match plugin.properties.get(name).map(|p| &p.value) {
+        None => Ok(default),
+        Some(Property::Rgb(c)) => Ok(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)),
+        Some(Property::Float(v)) => Ok(Vec3::splat(*v as f32)),
+        Some(other) => Err(format!(
+            "\"{name}\" must be an rgb or float, not a {}",
+            other.kind()
+        )),
+    }
+}
+
+/// An index of refraction given as a number or by name (the names Mitsuba accepts).
+fn index_of_refraction(
+    plugin: &Plugin,
+    name: &str,
+    default: f64,
+    warn: &mut dyn FnMut(String),
+) -> f64 {
+    match plugin.properties.get(name).map(|p| &p.value) {
+        None => default,
+        Some(Property::Float(v)) if *v > 0.0 => *v,
+        Some(Property::String(material)) => match named_index_of_refraction(material) {
+            Some(v) => v,
+            None => {
+                warn(format!(
+                    "\"{name}\": unknown material \"{material}\"; using {default}"
+                ));
+                default
+            }
+        },
+        Some(other) => {
+            warn(format!(
+                "\"{name}\" must be a positive float or a material name, not {other:?}; using {default}"
+            ));
+            default
+        }
+    }
+}
+
+/// Indices of refraction of common dielectrics at about 589 nm.
+fn named_index_of_refraction(material: &str) -> Option<f64> {
+    Some(match material.to_ascii_lowercase().as_str() {
+        "vacuum" => 1.0,
+        "helium" => 1.00004,
+        "hydrogen" => 1.00013,
+        "air" => 1.000277,
+        "carbon dioxide" => 1.00045,
+        "water" => 1.333,
+        "acetone" => 1.36,
+        "ethanol" => 1.361,
+        "carbon tetrachloride" => 1.461,
+        "glycerol" => 1.4729,
+        "benzene" => 1.501,
+        "silicone oil" => 1.52045,
+        "bromine" => 1.661,
+        "water ice" => 1.31,
+        "fused quartz" => 1.458,
+        "pyrex" => 1.47,
+        "acrylic glass" => 1.49,
+        "polypropylene" => 1.49,
+        "bk7" => 1.5046,
+        "sodium chloride" => 1.544,
+        "amber" => 1.55,
+        "pet" => 1.575,
+        "diamond" => 2.419,
+        _ => return None,
+    })
+}
+
+impl BsdfReader<'_> {
+    fn warn(&mut self, message: String) {
+        self.warnings.push(format!(
+            "{}:{}: {message}",
+            self.file.display(),
+            self.plugin.line
+        ));
+    }
+
+    /// The material this element describes.
+    pub fn material(&mut self) -> Material {
+        match self.plugin.kind.as_str() {
+            "diffuse" => {
+                let reflectance = self.colour("reflectance", Vec3::splat(0.5));
+                Material::diffuse(reflectance.min(Vec3::ONE))
+            }
+            "roughconductor" => self.rough_conductor(),
+            "roughplastic" => self.rough_plastic(),
+            "twosided" => {
+                let inner = match self.plugin.children.first() {
+                    Some(child) => Material::from_plugin(child, self.file, self.warnings),
+                    None => Material::default(),
+                };
+                Material {
+                    two_sided: true,
+                    ..inner
+                }
+            }
+            other => {
+                self.warn(format!(
+                    "bsdf \"{other}\" is not implemented; rendered as diffuse 0.5"
+                ));
+                Material::default()
+            }
+        }
+    }
+
+    /// A colour property: non-negative and finite, else `default` with a warning.
+    fn colour(&mut self, name: &str, default: Vec3) -> Vec3 {
+        match rgb(self.plugin, name, default) {
+            Ok(v) if v.is_finite() && v.min_element() >= 0.0 => v,
+            Ok(_) => {
+                self.warn("a colour is negative or not finite; using the default".into());
+                default
+            }
+            Err(message) => {
+                self.warn(format!("{message}; using the default"));
+                default
+            }
+        }
+    }
+
+    /// The microfacet distribution: Beckmann unless GGX is named (Mitsuba's default).
+    fn microfacet(&mut self) -> Microfacet {
+        let plugin = self.plugin;
+        if plugin.properties.contains_key("alpha_u") || plugin.properties.contains_key("alpha_v") {
+            self.warn("anisotropic alpha_u/alpha_v are not supported; using alpha".into());
+        }
+        let kind = match plugin.string("distribution") {
+            Ok(None) => MicrofacetKind::Beckmann,
+            Ok(Some(d)) if d.eq_ignore_ascii_case("beckmann") => MicrofacetKind::Beckmann,
+            Ok(Some(d)) if d.eq_ignore_ascii_case("ggx") => MicrofacetKind::Ggx,
+            Ok(Some(d)) => {
+                self.warn(format!(
+                    "microfacet distribution \"{d}\" is not beckmann or ggx; using beckmann"
+                ));
+                MicrofacetKind::Beckmann
+            }
+            Err((_, message)) => {
+                self.warn(message);
+                MicrofacetKind::Beckmann
+            }
+        };
+        Microfacet::new(kind, plugin.float("alpha", 0.1).unwrap_or(0.1) as f32)
+    }
+
+    /// A conductor's complex index of refraction: `eta` and `k`, or a named `material`.
+    fn conductor_ior(&mut self) -> (Vec3, Vec3) {
+        let plugin = self.plugin;
+        if plugin.properties.contains_key("eta") || plugin.properties.contains_key("k") {
+            return (self.colour("eta", Vec3::ZERO), self.colour("k", Vec3::ONE));
+        }
+        match plugin.string("material") {
+            Ok(None) | Ok(Some("none")) => (Vec3::ZERO, Vec3::ZERO),
+            Ok(Some(name)) => named_conductor(name).unwrap_or_else(|| {
+                self.warn(format!("conductor \"{name}\" is not in ais's table; using a perfect mirror (material \"none\")"));
+                (Vec3::ZERO, Vec3::ZERO)
+            }),
+            Err((_, message)) => {
+                self.warn(message);
+                (Vec3::ZERO, Vec3::ZERO)
+            }
+        }
+    }
+
+    fn rough_conductor(&mut self) -> Material {
+        let microfacet = self.microfacet();
+        let (eta, k) = self.conductor_ior();
+        let specular = self.colour("specular_reflectance", Vec3::ONE);
+        Material {
+            scattering: Scattering::RoughConductor {
+                microfacet,
+                eta,
+                k,
+                specular,
+            },
+            two_sided: false,
+        }
+    }
+
+    fn rough_plastic(&mut self) -> Material {
+        let microfacet = self.microfacet();
+        let plugin = self.plugin;
+        let mut warn = |message: String| self.warn(message);
+        let int_ior = index_of_refraction(plugin, "int_ior", 1.49, &mut warn);
+        let ext_ior = index_of_refraction(plugin, "ext_ior", 1.000277, &mut warn);
+        let diffuse = self.colour("diffuse_reflectance", Vec3::splat(0.5));
+        let specular = self.colour("specular_reflectance", Vec3::ONE);
+        let nonlinear = plugin.boolean("nonlinear", false).unwrap_or(false);
+        let eta = (int_ior / ext_ior) as f32;
+        let eta = if eta.is_finite() && eta > 0.0 && eta != 1.0 {
+            eta
+        } else {
+            self.warn(format!(
+                "int_ior / ext_ior = {eta} must be positive and not 1; using 1.49"
+            ));
+            1.49
+        };
+        Material {
+            scattering: Scattering::RoughPlastic(RoughPlastic::new(
+                microfacet,
+                eta,
+                diffuse.min(Vec3::ONE),
+                specular,
+                nonlinear,
+            )),
+            two_sided: false,
+        }
+    }
+}
