@@ -22,9 +22,13 @@ pub fn run(args: BenchArgs) -> Result<(), String> {
     if args.runs == 0 || args.threads.contains(&0) || args.gather_rays == 0 {
         return Err("--runs, --threads and --gather-rays must be positive".into());
     }
-    let (width, height) = args.resolution;
     eprintln!("measuring {} runs each; this takes a minute…", args.runs);
-    let rows = ais_study::benchmark::run(width, height, &args.threads, args.runs, args.gather_rays);
+    let rows = ais_study::benchmark::run(&ais_study::benchmark::BenchSettings {
+        resolution: args.resolution,
+        thread_counts: args.threads.clone(),
+        runs: args.runs,
+        gather_rays: args.gather_rays,
+    });
     println!("| measurement | threads | median time (s) | median rays/s |");
     println!("|---|---|---|---|");
     for row in rows {

@@ -128,14 +128,58 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
     Ok(list)
 }
 
-pub fn run(args: CompareArgs) -> Result<(), String> {
-    start_threads(args.threads)?;
+/// The key of the cached reference: the scene file's hash, the defines, the size and the
+/// reference's settings.
+fn reference_key(
+    args: &CompareArgs,
+    (width, height): (u32, u32),
+    rays: u32,
+) -> Result<String, String> {
+    let scene_identity = match &args.scene {
+        Some(path) => {
+            let bytes = std::fs::read(path)
+                .map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?;
+            format!("{:016x}", reference::fnv1a(&bytes))
+        }
+        None => "built-in default scene".into(),
+    };
+    Ok(format!(
+        "{scene_identity}|{:?}|{width}x{height}|{}|{}|{}|{}",
+        args.define,
+        args.reference_spp,
+        rays,
+        env!("CARGO_PKG_VERSION"),
+        "reference v2"
+    ))
+}
+
+/// The pixel of the affinity-map figure: the flag's, else the image centre.
+fn figure_pixel(args: &CompareArgs, (width, height): (u32, u32)) -> Result<(u32, u32), String> {
+    let pixel = args.pixel.unwrap_or((width / 2, height / 2));
+    if pixel.0 >= width || pixel.1 >= height {
+        return Err(format!(
+            "--pixel {},{} is outside the {width}×{height} image",
+            pixel.0, pixel.1
+        ));
+    }
+    Ok(pixel)
+}
+
+/// Checks the flags that need no scene.
+fn check_arguments(args: &CompareArgs) -> Result<(), String> {
     if !(args.time_budget > 0.0 && args.time_budget.is_finite()) {
         return Err("--time-budget must be a positive number of seconds".into());
     }
     if args.seeds == 0 || args.reference_spp == 0 || args.pass_spp == 0 {
         return Err("--seeds, --reference-spp and --pass-spp must be at least 1".into());
     }
+    Ok(())
+}
+
+/// `ais compare`.
+pub fn run(args: CompareArgs) -> Result<(), String> {
+    start_threads(args.threads)?;
+    check_arguments(&args)?;
     let world = load_world(
         args.scene.as_deref(),
         &args.define,
@@ -146,31 +190,8 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
         &world.description.file,
         world.description.integrator.as_ref(),
     )?;
-    let (width, height) = world.resolution;
-    let pixel = args.pixel.unwrap_or((width / 2, height / 2));
-    if pixel.0 >= width || pixel.1 >= height {
-        return Err(format!(
-            "--pixel {},{} is outside the {width}×{height} image",
-            pixel.0, pixel.1
-        ));
-    }
-    // The reference depends on the scene, its size and the reference settings.
-    let scene_identity = match &args.scene {
-        Some(path) => {
-            let bytes = std::fs::read(path)
-                .map_err(|e| format!("{}: cannot read the scene: {e}", path.display()))?;
-            format!("{:016x}", reference::fnv1a(&bytes))
-        }
-        None => "built-in default scene".into(),
-    };
-    let key = format!(
-        "{scene_identity}|{:?}|{width}x{height}|{}|{}|{}|{}",
-        args.define,
-        args.reference_spp,
-        base.rays,
-        env!("CARGO_PKG_VERSION"),
-        "reference v2"
-    );
+    let pixel = figure_pixel(&args, world.resolution)?;
+    let key = reference_key(&args, world.resolution, base.rays)?;
     let settings = StudySettings {
         configurations: configurations(&args, base)?,
         time_budget: Duration::from_secs_f64(args.time_budget),
@@ -181,8 +202,8 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
         figure_pixel: pixel,
         progress: !args.quiet && std::io::stderr().is_terminal(),
     };
-    let runs = settings.configurations.len() * 2 - 1;
     if !args.quiet {
+        let runs = settings.configurations.len() * 2 - 1;
         eprintln!(
             "studying {} configurations × {} seeds (about {:.0} s after the reference)…",
             settings.configurations.len(),

@@ -38,20 +38,10 @@ fn headless(browser: &Path) -> Command {
     command
 }
 
-#[test]
-fn the_compare_report_renders_and_its_controls_work_in_chromium() {
-    let Some(browser) = chromium() else {
-        assert!(
-            std::env::var_os("CI").is_none(),
-            "no Chromium found: .ci/run installs Debian's chromium (or set AIS_CHROMIUM)"
-        );
-        eprintln!("SKIPPED the browser test: no chromium, chromium-browser or google-chrome");
-        return;
-    };
+/// Runs `ais compare` on a small scene into `report`; returns the page's file URL.
+fn write_report(report: &Path) -> String {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let scratch = Path::new(env!("CARGO_TARGET_TMPDIR"));
-    let report = scratch.join("browser-report");
-    let _ = std::fs::remove_dir_all(&report);
+    let _ = std::fs::remove_dir_all(report);
     let compare = Command::new(env!("CARGO_BIN_EXE_ais"))
         .arg("compare")
         .arg(root.join("scenes/crosscheck/sphere_light.xml"))
@@ -64,7 +54,7 @@ fn the_compare_report_renders_and_its_controls_work_in_chromium() {
             "2",
         ])
         .args(["--reference-spp", "32", "--quiet", "-o"])
-        .arg(&report)
+        .arg(report)
         .output()
         .expect("ais runs");
     assert!(
@@ -73,8 +63,39 @@ fn the_compare_report_renders_and_its_controls_work_in_chromium() {
         String::from_utf8_lossy(&compare.stderr)
     );
     let page = report.join("index.html").canonicalize().unwrap();
-    let url = format!("file://{}", page.display());
+    format!("file://{}", page.display())
+}
 
+/// Takes a screenshot of `url` into `screenshot` and checks that it holds a page.
+fn screenshot(browser: &Path, url: &str, screenshot: &Path) {
+    let _ = std::fs::remove_file(screenshot);
+    let shot = headless(browser)
+        .arg(format!("--screenshot={}", screenshot.display()))
+        .arg("--window-size=1200,2400")
+        .arg(url)
+        .output()
+        .expect("chromium runs");
+    assert!(
+        shot.status.success(),
+        "{}",
+        String::from_utf8_lossy(&shot.stderr)
+    );
+    let size = std::fs::metadata(screenshot).map_or(0, |m| m.len());
+    assert!(size > 20_000, "the screenshot is {size} bytes");
+}
+
+#[test]
+fn the_compare_report_renders_and_its_controls_work_in_chromium() {
+    let Some(browser) = chromium() else {
+        assert!(
+            std::env::var_os("CI").is_none(),
+            "no Chromium found: .ci/run installs Debian's chromium (or set AIS_CHROMIUM)"
+        );
+        eprintln!("SKIPPED the browser test: no chromium, chromium-browser or google-chrome");
+        return;
+    };
+    let scratch = Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let url = write_report(&scratch.join("browser-report"));
     let dom = headless(&browser)
         .arg("--dump-dom")
         .arg(format!("{url}#selftest"))
@@ -90,20 +111,5 @@ fn the_compare_report_renders_and_its_controls_work_in_chromium() {
     assert!(result.contains("\"ok\":true"), "self-test failed: {result}");
     assert!(result.contains("\"plots\":2"), "{result}");
     assert!(!result.contains("\"maps\":0"), "{result}");
-
-    let screenshot = scratch.join("report-screenshot.png");
-    let _ = std::fs::remove_file(&screenshot);
-    let shot = headless(&browser)
-        .arg(format!("--screenshot={}", screenshot.display()))
-        .arg("--window-size=1200,2400")
-        .arg(&url)
-        .output()
-        .expect("chromium runs");
-    assert!(
-        shot.status.success(),
-        "{}",
-        String::from_utf8_lossy(&shot.stderr)
-    );
-    let size = std::fs::metadata(&screenshot).map_or(0, |m| m.len());
-    assert!(size > 20_000, "the screenshot is {size} bytes");
+    screenshot(&browser, &url, &scratch.join("report-screenshot.png"));
 }

@@ -119,8 +119,9 @@ pub fn procedural_sky(width: usize, height: usize) -> RgbImage {
     image
 }
 
-/// The built-in default scene at `width × height` pixels.
-pub fn default_world(width: u32, height: u32) -> World {
+/// The shapes and area lights of the default scene: the sculpture, the ground, the
+/// rectangle light and two sphere lights, in that order.
+fn shapes_and_lights() -> (Vec<ShapeInput>, Vec<AreaLight>) {
     let sculpture =
         crate::mesh::validate(std::path::Path::new("<built-in sculpture>"), sculpture())
             .expect("the procedural sculpture is valid")
@@ -138,6 +139,13 @@ pub fn default_world(width: u32, height: u32) -> World {
     .expect("valid look-at")
         * DMat4::from_scale(DVec3::splat(0.35));
     let panel = shapes::rectangle().transformed(panel_transform, false, false);
+    let panel_light = area_light(&panel, true, false, Vec3::new(12.0, 12.0, 11.0), 2);
+    let mesh = |mesh| ShapeInput {
+        geometry: ShapeGeometry::Mesh(mesh),
+        flip_normals: false,
+    };
+    let mut inputs = vec![mesh(sculpture), mesh(ground), mesh(panel)];
+    let mut lights = vec![panel_light];
     let spheres = [
         (
             Vec3::new(1.55, 0.55, 1.25),
@@ -150,34 +158,13 @@ pub fn default_world(width: u32, height: u32) -> World {
             Vec3::new(8.0, 12.0, 25.0),
         ),
     ];
-    let mut inputs = vec![
-        ShapeInput {
-            geometry: ShapeGeometry::Mesh(sculpture),
-            flip_normals: false,
-        },
-        ShapeInput {
-            geometry: ShapeGeometry::Mesh(ground),
-            flip_normals: false,
-        },
-        ShapeInput {
-            geometry: ShapeGeometry::Mesh(panel.clone()),
-            flip_normals: false,
-        },
-    ];
-    let mut area = vec![area_light(
-        &panel,
-        true,
-        false,
-        Vec3::new(12.0, 12.0, 11.0),
-        2,
-    )];
     for (index, (center, radius, radiance)) in spheres.into_iter().enumerate() {
         let sphere = Sphere { center, radius };
         inputs.push(ShapeInput {
             geometry: ShapeGeometry::Sphere(sphere),
             flip_normals: false,
         });
-        area.push(AreaLight {
+        lights.push(AreaLight {
             shape: AreaShape::Sphere {
                 sphere,
                 flipped: false,
@@ -186,6 +173,12 @@ pub fn default_world(width: u32, height: u32) -> World {
             shape_index: 3 + index as u32,
         });
     }
+    (inputs, lights)
+}
+
+/// The built-in default scene at `width × height` pixels.
+pub fn default_world(width: u32, height: u32) -> World {
+    let (inputs, area) = shapes_and_lights();
     let geometry = Geometry::build(inputs);
     let environment = Environment::Map(Box::new(EnvironmentMap::new(
         procedural_sky(512, 256),

@@ -54,6 +54,33 @@ fn shape_material(
     }
 }
 
+/// An analytic sphere (centre, radius) under the shape's `to_world`, with its area light.
+fn sphere_shape(
+    file: &std::path::Path,
+    shape: &scene::ShapeDescription,
+    (center, radius): (glam::DVec3, f64),
+    radiance: Option<Vec3>,
+    index: u32,
+) -> Result<BuiltShape, InputError> {
+    let geometry = shapes::sphere(file, shape.line, center, radius, shape.to_world)?;
+    let light = match (radiance, &geometry) {
+        (Some(radiance), ShapeGeometry::Sphere(sphere)) => Some(AreaLight {
+            shape: AreaShape::Sphere {
+                sphere: *sphere,
+                flipped: shape.flip_normals,
+            },
+            radiance,
+            shape_index: index,
+        }),
+        _ => None,
+    };
+    let input = ShapeInput {
+        geometry,
+        flip_normals: shape.flip_normals,
+    };
+    Ok(BuiltShape { input, light })
+}
+
 /// Loads, transforms and validates shape number `index`, with its area light.
 fn build_shape(
     file: &std::path::Path,
@@ -68,23 +95,7 @@ fn build_shape(
         .transpose()?;
     let mesh = match &shape.geometry {
         scene::ShapeGeometry::Sphere { center, radius } => {
-            let geometry = shapes::sphere(file, shape.line, *center, *radius, shape.to_world)?;
-            let light = match (radiance, &geometry) {
-                (Some(radiance), ShapeGeometry::Sphere(sphere)) => Some(AreaLight {
-                    shape: AreaShape::Sphere {
-                        sphere: *sphere,
-                        flipped: shape.flip_normals,
-                    },
-                    radiance,
-                    shape_index: index,
-                }),
-                _ => None,
-            };
-            let input = ShapeInput {
-                geometry,
-                flip_normals: shape.flip_normals,
-            };
-            return Ok(BuiltShape { input, light });
+            return sphere_shape(file, shape, (*center, *radius), radiance, index)
         }
         scene::ShapeGeometry::Rectangle => shapes::rectangle(),
         scene::ShapeGeometry::Disk => shapes::disk(),

@@ -140,6 +140,22 @@ fn bvh_agrees_with_brute_force_on_random_rays() {
     assert!(hits > 1000, "the test must exercise hits: {hits}");
 }
 
+/// A random point on the sphere or on the acne test's triangle.
+fn random_surface_point(rng: &mut Pcg32, sphere: &Sphere) -> Vec3 {
+    if rng.next_f32() < 0.5 {
+        return sphere.center + random_unit(rng) * sphere.radius;
+    }
+    let (a, b) = (rng.next_f32(), rng.next_f32());
+    let (a, b) = if a + b > 1.0 {
+        (1.0 - a, 1.0 - b)
+    } else {
+        (a, b)
+    };
+    Vec3::new(500.0, 500.0, 500.0) * (1.0 - a - b)
+        + Vec3::new(530.0, 480.0, 510.0) * a
+        + Vec3::new(505.0, 530.0, 470.0) * b
+}
+
 #[test]
 fn offset_rays_do_not_hit_the_surface_they_leave() {
     // A large sphere and a tilted, far-from-origin triangle: leaving the surface outward must
@@ -171,19 +187,7 @@ fn offset_rays_do_not_hit_the_surface_they_leave() {
     let mut tested = 0;
     for _ in 0..20_000 {
         // A camera-like ray that hits something, then a ray leaving it on the normal's side.
-        let target = if rng.next_f32() < 0.5 {
-            sphere.center + random_unit(&mut rng) * sphere.radius
-        } else {
-            let (a, b) = (rng.next_f32(), rng.next_f32());
-            let (a, b) = if a + b > 1.0 {
-                (1.0 - a, 1.0 - b)
-            } else {
-                (a, b)
-            };
-            Vec3::new(500.0, 500.0, 500.0) * (1.0 - a - b)
-                + Vec3::new(530.0, 480.0, 510.0) * a
-                + Vec3::new(505.0, 530.0, 470.0) * b
-        };
+        let target = random_surface_point(&mut rng, &sphere);
         let origin = target + random_unit(&mut rng) * 200.0;
         let Some(hit) = geometry.intersect(&Ray::new(origin, (target - origin).normalize())) else {
             continue;

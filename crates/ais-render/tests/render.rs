@@ -25,76 +25,93 @@ fn render_with(world: &World, integrator: Integrator, spp: u32) -> RenderOutput<
     render(world, &integrator, &settings(spp))
 }
 
+/// Renders `integrator` on `world` with 2 spp on a pool of `threads` threads.
+fn on_threads(world: &World, threads: usize, integrator: Integrator) -> RenderOutput<GatherStats> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(|| render_with(world, integrator, 2))
+}
+
+fn bits(image: &ais_render::image_io::RgbImage) -> Vec<u32> {
+    image.pixels.iter().flatten().map(|c| c.to_bits()).collect()
+}
+
+/// Renders `settings` at 1 and 2 threads, checks that image and counts agree, and returns
+/// the first render.
+fn thread_independent(world: &World, settings: GatherSettings) -> RenderOutput<GatherStats> {
+    let one = on_threads(world, 1, Integrator::Gather(settings));
+    let two = on_threads(world, 2, Integrator::Gather(settings));
+    assert_eq!(bits(&one.image), bits(&two.image), "{settings:?}");
+    assert_eq!(one.stats.ais, two.stats.ais, "{settings:?}");
+    one
+}
+
 #[test]
 fn images_are_bit_identical_at_one_and_two_threads() {
-    // Both the gather (with AIS) and ambient occlusion.
+    let world = default_world(48, 27);
+    let per_batch = thread_independent(&world, GatherSettings::preset(Preset::Aggressive));
+    // Shared maps (with value-aware acceptance) learn across gathers in a fixed order.
+    let shared = thread_independent(
+        &world,
+        GatherSettings {
+            acceptance: Acceptance::ValueEfficient,
+            ..GatherSettings::preset(Preset::Shared)
+        },
+    );
+    assert!(shared.stats.ais.rejected_roulette > 0, "shared maps reject");
+    // Warm starts from the same maps, then per-batch learning, with √affinity acceptance.
+    let warm = GatherSettings {
+        acceptance: Acceptance::SqrtAffinity,
+        ..GatherSettings::preset(Preset::Warm)
+    };
+    thread_independent(&world, warm);
+    // Guided gathers build their proposal from the same neighbourhood maps.
+    let guided = thread_independent(&world, GatherSettings::preset(Preset::Guided));
+    assert_ne!(
+        bits(&guided.image),
+        bits(&per_batch.image),
+        "the guide changes the proposal"
+    );
+}
+
+#[test]
+fn maps_from_a_learning_pass_are_thread_independent() {
+    // A tile's learning gathers at its edges are also computed by its neighbour tiles, on
+    // another thread, and must agree.
+    let world = default_world(48, 27);
+    let with = |preset, stride| GatherSettings {
+        sharing: Sharing::LearningPass { stride },
+        ..GatherSettings::preset(preset)
+    };
+    let from_a_pass = thread_independent(&world, with(Preset::Shared, 4));
+    assert!(
+        from_a_pass.stats.ais.rejected_roulette > 0,
+        "learned maps reject"
+    );
+    let tile_order = on_threads(
+        &world,
+        1,
+        Integrator::Gather(GatherSettings::preset(Preset::Shared)),
+    );
+    assert_ne!(
+        bits(&from_a_pass.image),
+        bits(&tile_order.image),
+        "a learning pass is another source of maps"
+    );
+    thread_independent(&world, with(Preset::Warm, 8));
+}
+
+#[test]
+fn ambient_occlusion_is_thread_independent() {
     let world = default_world(48, 27);
     let ao = Integrator::AmbientOcclusion(AmbientOcclusion {
         rays: 4,
         distance: 1.0,
     });
-    let gather = Integrator::Gather(GatherSettings::preset(Preset::Aggressive));
-    let on_threads = |threads: usize, integrator: Integrator| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| render_with(&world, integrator, 2))
-    };
-    let bits = |image: &ais_render::image_io::RgbImage| -> Vec<u32> {
-        image.pixels.iter().flatten().map(|c| c.to_bits()).collect()
-    };
-    let lit_one = on_threads(1, gather);
-    let lit_two = on_threads(2, gather);
-    assert_eq!(bits(&lit_one.image), bits(&lit_two.image));
-    assert_eq!(lit_one.stats.ais, lit_two.stats.ais);
-    // Renders `settings` at 1 and 2 threads and checks that image and counts agree.
-    let thread_independent = |settings: GatherSettings| {
-        let one = on_threads(1, Integrator::Gather(settings));
-        let two = on_threads(2, Integrator::Gather(settings));
-        assert_eq!(bits(&one.image), bits(&two.image), "{settings:?}");
-        assert_eq!(one.stats.ais, two.stats.ais, "{settings:?}");
-        one
-    };
-    // Shared maps (with value-aware acceptance) learn across gathers in a fixed order.
-    let shared = thread_independent(GatherSettings {
-        acceptance: Acceptance::ValueEfficient,
-        ..GatherSettings::preset(Preset::Shared)
-    });
-    assert!(shared.stats.ais.rejected_roulette > 0, "shared maps reject");
-    // Warm starts from the same maps, then per-batch learning, with √affinity acceptance.
-    thread_independent(GatherSettings {
-        acceptance: Acceptance::SqrtAffinity,
-        ..GatherSettings::preset(Preset::Warm)
-    });
-    // Maps from a learning pass around each tile: a tile's learning gathers at its edges
-    // are also computed by its neighbour tiles, on another thread, and must agree.
-    let from_a_pass = thread_independent(GatherSettings {
-        sharing: Sharing::LearningPass { stride: 4 },
-        ..GatherSettings::preset(Preset::Shared)
-    });
-    assert!(
-        from_a_pass.stats.ais.rejected_roulette > 0,
-        "learned maps reject"
-    );
-    assert_ne!(
-        bits(&from_a_pass.image),
-        bits(&shared.image),
-        "a learning pass is another source of maps"
-    );
-    thread_independent(GatherSettings {
-        sharing: Sharing::LearningPass { stride: 8 },
-        ..GatherSettings::preset(Preset::Warm)
-    });
-    // Guided gathers build their proposal from the same neighbourhood maps.
-    let guided = thread_independent(GatherSettings::preset(Preset::Guided));
-    assert_ne!(
-        bits(&guided.image),
-        bits(&lit_one.image),
-        "the guide changes the proposal"
-    );
-    let one = on_threads(1, ao);
-    let two = on_threads(2, ao);
+    let one = on_threads(&world, 1, ao);
+    let two = on_threads(&world, 2, ao);
     assert_eq!(bits(&one.image), bits(&two.image));
     assert_eq!(one.rays, two.rays);
     // The image is not trivially uniform: the sculpture occludes.

@@ -5,7 +5,7 @@
 use ais::rng::Pcg32;
 use ais::sampling::cosine_hemisphere;
 use ais_render::default_scene::default_world;
-use ais_render::geometry::{basis, spawn_ray, Geometry};
+use ais_render::geometry::{basis, spawn_ray, Geometry, Hit};
 use ais_render::world::World;
 use rayon::prelude::*;
 use std::time::Instant;
@@ -59,85 +59,101 @@ fn measure(threads: usize, runs: usize, work: impl Fn() -> u64 + Sync) -> (f64, 
     (median(rates), median(times))
 }
 
-/// Measures the default scene at `width × height`, for each thread count, `runs` times.
-pub fn run(
-    width: u32,
-    height: u32,
-    thread_counts: &[usize],
-    runs: usize,
-    gather_rays: u32,
-) -> Vec<BenchRow> {
-    let mut rows = Vec::new();
+/// What `ais bench` measures.
+#[derive(Clone, Debug)]
+pub struct BenchSettings {
+    /// Image size whose pixel-centre camera rays are traced, `(width, height)`.
+    pub resolution: (u32, u32),
+    /// Thread counts to measure.
+    pub thread_counts: Vec<usize>,
+    /// Runs per measurement (the median is reported).
+    pub runs: usize,
+    /// Rays per gather.
+    pub gather_rays: u32,
+}
+
+/// The median BVH build time of the default scene over `runs` builds, and the last world.
+fn bvh_row(settings: &BenchSettings) -> (BenchRow, World) {
+    let (width, height) = settings.resolution;
     let mut build_times = Vec::new();
     let mut world = default_world(width, height);
-    for _ in 0..runs {
+    for _ in 0..settings.runs {
         world = default_world(width, height);
         build_times.push(world.geometry.build_time().as_secs_f64());
     }
-    rows.push(BenchRow {
+    let row = BenchRow {
         name: format!("BVH build ({} triangles)", world.geometry.triangle_count()),
         threads: rayon::current_num_threads(),
         rays_per_second: 0.0,
         seconds: median(build_times),
-    });
+    };
+    (row, world)
+}
+
+/// Cosine-distributed gathers of `rays` rays from every hit, closest-hit or occlusion
+/// queries; returns the rays traced.
+fn trace_gathers(geometry: &Geometry, hits: &[Hit], rays: u32, closest: bool) -> u64 {
+    hits.par_iter()
+        .enumerate()
+        .map(|(i, hit)| {
+            let mut rng = Pcg32::new(i as u64, 3);
+            let n = hit.geometric_normal;
+            let (t, b) = basis(n);
+            for _ in 0..rays {
+                let l = cosine_hemisphere([rng.next_f32(), rng.next_f32()]);
+                let d = (t * l.x + b * l.y + n * l.z).normalize();
+                let ray = spawn_ray(hit.point, n, d);
+                if closest {
+                    std::hint::black_box(geometry.intersect(&ray));
+                } else {
+                    std::hint::black_box(geometry.occluded(&ray));
+                }
+            }
+            rays as u64
+        })
+        .sum()
+}
+
+/// Measures the default scene for each thread count.
+pub fn run(settings: &BenchSettings) -> Vec<BenchRow> {
+    let (bvh, world) = bvh_row(settings);
+    let mut rows = vec![bvh];
     let rays = camera_rays(&world);
     let geometry: &Geometry = &world.geometry;
     // First hits, for the gathers.
-    let hits: Vec<_> = rays.iter().filter_map(|r| geometry.intersect(r)).collect();
-    for &threads in thread_counts {
-        let (rate, seconds) = measure(threads, runs, || {
-            rays.par_iter()
-                .filter(|r| geometry.intersect(r).is_some())
-                .count();
-            rays.len() as u64
-        });
-        rows.push(BenchRow {
-            name: "camera rays, closest hit".into(),
-            threads,
-            rays_per_second: rate,
-            seconds,
-        });
-        let (rate, seconds) = measure(threads, runs, || {
-            rays.par_iter().filter(|r| geometry.occluded(r)).count();
-            rays.len() as u64
-        });
-        rows.push(BenchRow {
-            name: "camera rays, occlusion".into(),
-            threads,
-            rays_per_second: rate,
-            seconds,
-        });
-        for closest in [true, false] {
-            let (rate, seconds) = measure(threads, runs, || {
-                hits.par_iter()
-                    .enumerate()
-                    .map(|(i, hit)| {
-                        let mut rng = Pcg32::new(i as u64, 3);
-                        let n = hit.geometric_normal;
-                        let (t, b) = basis(n);
-                        for _ in 0..gather_rays {
-                            let l = cosine_hemisphere([rng.next_f32(), rng.next_f32()]);
-                            let d = (t * l.x + b * l.y + n * l.z).normalize();
-                            let ray = spawn_ray(hit.point, n, d);
-                            if closest {
-                                std::hint::black_box(geometry.intersect(&ray));
-                            } else {
-                                std::hint::black_box(geometry.occluded(&ray));
-                            }
-                        }
-                        gather_rays as u64
-                    })
-                    .sum::<u64>()
-            });
+    let hits: Vec<Hit> = rays.iter().filter_map(|r| geometry.intersect(r)).collect();
+    let runs = settings.runs;
+    for &threads in &settings.thread_counts {
+        let mut row = |name: String, (rate, seconds): (f64, f64)| {
             rows.push(BenchRow {
-                name: format!(
-                    "{gather_rays}-ray gathers (cosine), {}",
-                    if closest { "closest hit" } else { "occlusion" }
-                ),
+                name,
                 threads,
                 rays_per_second: rate,
                 seconds,
-            });
+            })
+        };
+        row(
+            "camera rays, closest hit".into(),
+            measure(threads, runs, || {
+                rays.par_iter()
+                    .filter(|r| geometry.intersect(r).is_some())
+                    .count();
+                rays.len() as u64
+            }),
+        );
+        row(
+            "camera rays, occlusion".into(),
+            measure(threads, runs, || {
+                rays.par_iter().filter(|r| geometry.occluded(r)).count();
+                rays.len() as u64
+            }),
+        );
+        for (closest, kind) in [(true, "closest hit"), (false, "occlusion")] {
+            let n = settings.gather_rays;
+            row(
+                format!("{n}-ray gathers (cosine), {kind}"),
+                measure(threads, runs, || trace_gathers(geometry, &hits, n, closest)),
+            );
         }
     }
     rows

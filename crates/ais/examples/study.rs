@@ -10,7 +10,7 @@
 //! Run: `cargo run --release -p ais --example study -- [--batches N] [--section NAME]...`.
 //! Sections: `rules` (the full grid), `heights`, `placement`, `stopping`, `proposals`.
 
-use ais::analytic::{gather, GatherTarget, Moments, Proposal, Scene};
+use ais::analytic::{AnalyticGather, GatherTarget, Moments, Proposal, Scene};
 use ais::{
     Batch, BatchConfig, Learning, LevelRule, MapConfig, MapStart, Mode, Placement, Stopping,
 };
@@ -55,15 +55,13 @@ fn measure(setup: &Setup, scene: &Scene, proposal: Proposal, n: u32, batches: u3
     let mut batch: Batch<f64> = Batch::new(setup.config).expect("valid study configuration");
     let mut moments = Moments::default();
     for seed in 0..batches {
-        let estimate = gather(
-            &mut batch,
+        let job = AnalyticGather {
             scene,
             proposal,
             n,
-            seed as u64,
-            MapStart::Empty,
-            setup.target,
-        );
+            target: setup.target,
+        };
+        let estimate = job.run(&mut batch, seed as u64, MapStart::Empty);
         moments.add(estimate.value);
     }
     let count = batches as f64;
@@ -396,68 +394,23 @@ fn stopping_section(batches: u32) {
         Mode::Aggressive,
         LevelRule::Single,
     ));
-    let epochs = Learning::Epochs { epochs: 4 };
-    let rows = [
+    let rules = [
+        ("random, n+1", Placement::Random, Stopping::DropLast),
+        ("random, stop at n", Placement::Random, Stopping::AtN),
+        ("Halton, n+1", Placement::Halton, Stopping::DropLast),
         (
-            "oracle, random, n+1",
-            None,
-            Learning::Off,
-            Stopping::DropLast,
-            Placement::Random,
-        ),
-        (
-            "oracle, random, stop at n",
-            None,
-            Learning::Off,
-            Stopping::AtN,
-            Placement::Random,
-        ),
-        (
-            "oracle, Halton, n+1",
-            None,
-            Learning::Off,
-            Stopping::DropLast,
+            "Halton, budget",
             Placement::Halton,
-        ),
-        (
-            "oracle, Halton, budget",
-            None,
-            Learning::Off,
             Stopping::CandidateBudget,
-            Placement::Halton,
-        ),
-        (
-            "epochs, random, n+1",
-            map,
-            epochs,
-            Stopping::DropLast,
-            Placement::Random,
-        ),
-        (
-            "epochs, random, stop at n",
-            map,
-            epochs,
-            Stopping::AtN,
-            Placement::Random,
-        ),
-        (
-            "epochs, Halton, n+1",
-            map,
-            epochs,
-            Stopping::DropLast,
-            Placement::Halton,
-        ),
-        (
-            "epochs, Halton, budget",
-            map,
-            epochs,
-            Stopping::CandidateBudget,
-            Placement::Halton,
         ),
     ];
-    let setups: Vec<Setup> = rows
-        .iter()
-        .map(|&(label, affinity, learning, stopping, placement)| {
+    let mut setups = Vec::new();
+    for (prefix, affinity, learning) in [
+        ("oracle", None, Learning::Off),
+        ("epochs", map, Learning::Epochs { epochs: 4 }),
+    ] {
+        for (rule, placement, stopping) in rules {
+            let label = format!("{prefix}, {rule}");
             let config = BatchConfig {
                 affinity,
                 learning,
@@ -465,13 +418,12 @@ fn stopping_section(batches: u32) {
                 placement,
                 ..BatchConfig::default()
             };
-            if affinity.is_none() {
-                Setup::oracle(label, config)
-            } else {
-                Setup::new(label, config)
-            }
-        })
-        .collect();
+            setups.push(match affinity {
+                None => Setup::oracle(&label, config),
+                Some(_) => Setup::new(&label, config),
+            });
+        }
+    }
     study(
         Table {
             title: "Stopping rule and placement (maps: aggressive, single level, h 8, tol ∞); variance gain vs the first row (z of bias)",

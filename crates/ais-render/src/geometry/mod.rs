@@ -71,69 +71,72 @@ impl Geometry {
     /// Builds the BVH over all shapes.
     pub fn build(shapes: Vec<ShapeInput>) -> Self {
         let started = Instant::now();
-        let mut primitives = Vec::new();
-        let mut primitive_shapes = Vec::new();
-        let mut meshes = Vec::new();
-        let mut shape_flips = Vec::new();
-        let mut triangle_count = 0;
+        let mut geometry = Geometry {
+            primitives: Vec::new(),
+            primitive_shapes: Vec::new(),
+            meshes: Vec::new(),
+            shape_flips: Vec::new(),
+            bvh: None,
+            triangle_count: 0,
+            build_time: Duration::ZERO,
+        };
         for (shape_index, shape) in shapes.into_iter().enumerate() {
-            shape_flips.push(shape.flip_normals);
-            match shape.geometry {
-                ShapeGeometry::Sphere(sphere) => {
-                    primitives.push(Primitive::Sphere(sphere));
-                    primitive_shapes.push(shape_index as u32);
+            geometry.add(shape_index as u32, shape);
+        }
+        geometry.build_bvh();
+        geometry.build_time = started.elapsed();
+        geometry
+    }
+
+    /// Appends a shape's primitives.
+    fn add(&mut self, shape_index: u32, shape: ShapeInput) {
+        self.shape_flips.push(shape.flip_normals);
+        match shape.geometry {
+            ShapeGeometry::Sphere(sphere) => {
+                self.primitives.push(Primitive::Sphere(sphere));
+                self.primitive_shapes.push(shape_index);
+            }
+            ShapeGeometry::Mesh(mesh) => {
+                let mesh_index = self.meshes.len() as u32;
+                for (index, &[a, b, c]) in mesh.triangles.iter().enumerate() {
+                    self.primitives.push(Primitive::Triangle(Triangle {
+                        vertices: [
+                            mesh.positions[a as usize],
+                            mesh.positions[b as usize],
+                            mesh.positions[c as usize],
+                        ],
+                        mesh: mesh_index,
+                        index: index as u32,
+                    }));
+                    self.primitive_shapes.push(shape_index);
                 }
-                ShapeGeometry::Mesh(mesh) => {
-                    let mesh_index = meshes.len() as u32;
-                    for (index, &[a, b, c]) in mesh.triangles.iter().enumerate() {
-                        primitives.push(Primitive::Triangle(Triangle {
-                            vertices: [
-                                mesh.positions[a as usize],
-                                mesh.positions[b as usize],
-                                mesh.positions[c as usize],
-                            ],
-                            mesh: mesh_index,
-                            index: index as u32,
-                        }));
-                        primitive_shapes.push(shape_index as u32);
-                    }
-                    triangle_count += mesh.triangles.len();
-                    meshes.push(MeshShading {
-                        normals: mesh.normals,
-                        triangles: mesh.triangles,
-                    });
-                }
+                self.triangle_count += mesh.triangles.len();
+                self.meshes.push(MeshShading {
+                    normals: mesh.normals,
+                    triangles: mesh.triangles,
+                });
             }
         }
-        let bvh = (!primitives.is_empty()).then(|| {
-            obvhs::cwbvh::builder::build_cwbvh(
-                &primitives,
-                obvhs::BvhBuildParams::medium_build(),
-                &mut Duration::default(),
-            )
-        });
-        // Reorder primitives into BVH order so traversal needs no indirection.
-        if let Some(bvh) = &bvh {
-            primitives = bvh
-                .primitive_indices
-                .iter()
-                .map(|&i| primitives[i as usize])
-                .collect();
-            primitive_shapes = bvh
-                .primitive_indices
-                .iter()
-                .map(|&i| primitive_shapes[i as usize])
-                .collect();
+    }
+
+    /// Builds the BVH and reorders the primitives into its order, so that traversal needs no
+    /// indirection.
+    fn build_bvh(&mut self) {
+        if self.primitives.is_empty() {
+            return;
         }
-        Geometry {
-            primitives,
-            primitive_shapes,
-            meshes,
-            shape_flips,
-            bvh,
-            triangle_count,
-            build_time: started.elapsed(),
-        }
+        let bvh = obvhs::cwbvh::builder::build_cwbvh(
+            &self.primitives,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let order = &bvh.primitive_indices;
+        self.primitives = order.iter().map(|&i| self.primitives[i as usize]).collect();
+        self.primitive_shapes = order
+            .iter()
+            .map(|&i| self.primitive_shapes[i as usize])
+            .collect();
+        self.bvh = Some(bvh);
     }
 
     /// Number of triangles.

@@ -6,12 +6,8 @@ use crate::error::InputError;
 use glam::{Mat4, Vec3};
 use std::path::Path;
 
-/// Reads every triangle primitive of the default scene's nodes, with node transforms applied.
-pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
-    let bytes =
-        std::fs::read(path).map_err(|e| InputError::new(path, format!("cannot read GLB: {e}")))?;
-    let gltf = gltf::Gltf::from_slice(&bytes)
-        .map_err(|e| InputError::new(path, format!("cannot read GLB: {e}")))?;
+/// Refuses files that need an extension ais cannot decode.
+fn check_extensions(path: &Path, gltf: &gltf::Gltf) -> Result<(), InputError> {
     for extension in gltf.extensions_required() {
         if extension == "KHR_draco_mesh_compression" {
             return Err(InputError::new(
@@ -27,10 +23,91 @@ pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
             ));
         }
     }
-    let blob = gltf.blob.as_deref();
-    let mut mesh = TriangleMesh::default();
-    let mut normals: Vec<Vec3> = Vec::new();
-    let mut all_have_normals = true;
+    Ok(())
+}
+
+/// The mesh being assembled from the file's primitives.
+struct Assembly<'a> {
+    path: &'a Path,
+    blob: Option<&'a [u8]>,
+    mesh: TriangleMesh,
+    normals: Vec<Vec3>,
+    all_have_normals: bool,
+}
+
+impl Assembly<'_> {
+    /// Appends one triangle primitive under `transform`.
+    fn add(
+        &mut self,
+        primitive: &gltf::Primitive,
+        mesh_index: usize,
+        transform: Mat4,
+    ) -> Result<(), InputError> {
+        if primitive.mode() != gltf::mesh::Mode::Triangles {
+            return Err(InputError::new(
+                self.path,
+                format!(
+                    "mesh {mesh_index} has a {:?} primitive; only triangles are supported",
+                    primitive.mode()
+                ),
+            ));
+        }
+        let blob = self.blob;
+        let reader = primitive.reader(|buffer| match buffer.source() {
+            gltf::buffer::Source::Bin => blob,
+            gltf::buffer::Source::Uri(_) => None,
+        });
+        let positions: Vec<Vec3> = reader
+            .read_positions()
+            .ok_or_else(|| {
+                InputError::new(self.path, "a primitive has no readable POSITION data (external or compressed buffers are not supported)")
+            })?
+            .map(|p| transform.transform_point3(Vec3::from(p)))
+            .collect();
+        let base = self.mesh.positions.len() as u32;
+        let normal_matrix = transform.inverse().transpose();
+        match reader.read_normals() {
+            Some(n) if self.all_have_normals => self.normals.extend(n.map(|n| {
+                normal_matrix
+                    .transform_vector3(Vec3::from(n))
+                    .normalize_or_zero()
+            })),
+            _ => self.all_have_normals = false,
+        }
+        let count = positions.len() as u32;
+        self.mesh.positions.extend(positions);
+        match reader.read_indices() {
+            Some(indices) => {
+                let indices: Vec<u32> = indices.into_u32().collect();
+                self.mesh.triangles.extend(
+                    indices
+                        .chunks_exact(3)
+                        .map(|t| [base + t[0], base + t[1], base + t[2]]),
+                );
+            }
+            None => self
+                .mesh
+                .triangles
+                .extend((0..count / 3).map(|t| [base + 3 * t, base + 3 * t + 1, base + 3 * t + 2])),
+        }
+        Ok(())
+    }
+}
+
+/// Reads every triangle primitive of the default scene's nodes, with node transforms applied.
+pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
+    let bytes =
+        std::fs::read(path).map_err(|e| InputError::new(path, format!("cannot read GLB: {e}")))?;
+    let gltf = gltf::Gltf::from_slice(&bytes)
+        .map_err(|e| InputError::new(path, format!("cannot read GLB: {e}")))?;
+    check_extensions(path, &gltf)?;
+    let mut assembly = Assembly {
+        path,
+        blob: gltf.blob.as_deref(),
+        mesh: TriangleMesh::default(),
+        normals: Vec::new(),
+        all_have_normals: true,
+    };
     let scene = gltf
         .default_scene()
         .or_else(|| gltf.scenes().next())
@@ -39,58 +116,18 @@ pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
     while let Some((node, parent)) = stack.pop() {
         let transform = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         stack.extend(node.children().map(|c| (c, transform)));
-        let Some(gltf_mesh) = node.mesh() else {
-            continue;
-        };
-        let normal_matrix = transform.inverse().transpose();
-        for primitive in gltf_mesh.primitives() {
-            if primitive.mode() != gltf::mesh::Mode::Triangles {
-                return Err(InputError::new(
-                    path,
-                    format!(
-                        "mesh {} has a {:?} primitive; only triangles are supported",
-                        gltf_mesh.index(),
-                        primitive.mode()
-                    ),
-                ));
-            }
-            let reader = primitive.reader(|buffer| match buffer.source() {
-                gltf::buffer::Source::Bin => blob,
-                gltf::buffer::Source::Uri(_) => None,
-            });
-            let positions: Vec<Vec3> = reader
-                .read_positions()
-                .ok_or_else(|| {
-                    InputError::new(path, "a primitive has no readable POSITION data (external or compressed buffers are not supported)")
-                })?
-                .map(|p| transform.transform_point3(Vec3::from(p)))
-                .collect();
-            let base = mesh.positions.len() as u32;
-            match reader.read_normals() {
-                Some(n) if all_have_normals => normals.extend(n.map(|n| {
-                    normal_matrix
-                        .transform_vector3(Vec3::from(n))
-                        .normalize_or_zero()
-                })),
-                _ => all_have_normals = false,
-            }
-            let count = positions.len() as u32;
-            mesh.positions.extend(positions);
-            match reader.read_indices() {
-                Some(indices) => {
-                    let indices: Vec<u32> = indices.into_u32().collect();
-                    mesh.triangles.extend(
-                        indices
-                            .chunks_exact(3)
-                            .map(|t| [base + t[0], base + t[1], base + t[2]]),
-                    );
-                }
-                None => mesh.triangles.extend(
-                    (0..count / 3).map(|t| [base + 3 * t, base + 3 * t + 1, base + 3 * t + 2]),
-                ),
+        if let Some(gltf_mesh) = node.mesh() {
+            for primitive in gltf_mesh.primitives() {
+                assembly.add(&primitive, gltf_mesh.index(), transform)?;
             }
         }
     }
+    let Assembly {
+        mut mesh,
+        normals,
+        all_have_normals,
+        ..
+    } = assembly;
     if all_have_normals && normals.len() == mesh.positions.len() && !normals.is_empty() {
         mesh.normals = Some(normals);
     }

@@ -11,20 +11,12 @@ fn scalar(element: &DefaultElement, name: &str) -> Option<f32> {
     element.get(name).and_then(Property::to_f32_lossy)
 }
 
-/// Reads the `vertex` (x, y, z and optional nx, ny, nz) and `face` (vertex_indices or
-/// vertex_index; polygons are fanned into triangles) elements.
-pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
-    let file = std::fs::File::open(path)
-        .map_err(|e| InputError::new(path, format!("cannot open PLY: {e}")))?;
-    let mut reader = std::io::BufReader::new(file);
-    let ply = Parser::<DefaultElement>::new()
-        .read_ply(&mut reader)
-        .map_err(|e| InputError::new(path, format!("cannot read PLY: {e}")))?;
-    let vertices = ply
-        .payload
-        .get("vertex")
-        .ok_or_else(|| InputError::new(path, "PLY has no \"vertex\" element"))?;
-    let mut mesh = TriangleMesh::default();
+/// The `vertex` element's positions, and its normals if every vertex has them.
+fn read_vertices(
+    path: &Path,
+    vertices: &[DefaultElement],
+    mesh: &mut TriangleMesh,
+) -> Result<(), InputError> {
     let mut normals = Vec::with_capacity(vertices.len());
     for (index, vertex) in vertices.iter().enumerate() {
         let coordinate = |name| {
@@ -51,10 +43,15 @@ pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
     if normals.len() == mesh.positions.len() && !normals.is_empty() {
         mesh.normals = Some(normals);
     }
-    let faces = ply
-        .payload
-        .get("face")
-        .ok_or_else(|| InputError::new(path, "PLY has no \"face\" element"))?;
+    Ok(())
+}
+
+/// The `face` element's polygons, fanned into triangles.
+fn read_faces(
+    path: &Path,
+    faces: &[DefaultElement],
+    mesh: &mut TriangleMesh,
+) -> Result<(), InputError> {
     for (index, face) in faces.iter().enumerate() {
         let list = face
             .get("vertex_indices")
@@ -73,5 +70,25 @@ pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
             mesh.triangles.push([list[0], list[k], list[k + 1]]);
         }
     }
+    Ok(())
+}
+
+/// Reads the `vertex` (x, y, z and optional nx, ny, nz) and `face` (vertex_indices or
+/// vertex_index; polygons are fanned into triangles) elements.
+pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
+    let file = std::fs::File::open(path)
+        .map_err(|e| InputError::new(path, format!("cannot open PLY: {e}")))?;
+    let mut reader = std::io::BufReader::new(file);
+    let ply = Parser::<DefaultElement>::new()
+        .read_ply(&mut reader)
+        .map_err(|e| InputError::new(path, format!("cannot read PLY: {e}")))?;
+    let element = |name: &str| {
+        ply.payload
+            .get(name)
+            .ok_or_else(|| InputError::new(path, format!("PLY has no \"{name}\" element")))
+    };
+    let mut mesh = TriangleMesh::default();
+    read_vertices(path, element("vertex")?, &mut mesh)?;
+    read_faces(path, element("face")?, &mut mesh)?;
     Ok(mesh)
 }

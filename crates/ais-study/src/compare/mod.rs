@@ -332,6 +332,104 @@ fn bar(progress: &MultiProgress, enabled: bool, template: &str) -> ProgressBar {
     bar
 }
 
+/// The study's reference: cached in the given files, or in temporary ones removed after.
+fn study_reference(
+    world: &World,
+    settings: &StudySettings,
+    progress: &ProgressBar,
+) -> Result<reference::Reference, String> {
+    let base = settings.configurations[0].settings;
+    match &settings.reference_cache {
+        Some(paths) => reference::reference(world, &base, settings.reference_spp, paths, progress),
+        None => {
+            let key = format!("ais study {}", std::process::id());
+            let paths = reference::cache_paths(&std::env::temp_dir(), &key);
+            let result =
+                reference::reference(world, &base, settings.reference_spp, &paths, progress);
+            for path in &paths {
+                let _ = std::fs::remove_file(path);
+            }
+            result
+        }
+    }
+}
+
+/// The seed of run `s` of every configuration.
+fn seed_of(s: u32) -> u64 {
+    mix64(0xa15 ^ s as u64)
+}
+
+/// What the runs share: the scene, the reference, the settings and the progress bar.
+struct Runner<'a> {
+    world: &'a World,
+    reference: &'a reference::Reference,
+    settings: &'a StudySettings,
+    bar: &'a ProgressBar,
+}
+
+impl Runner<'_> {
+    /// Every configuration at equal time (but the oracle), then at equal rays with the
+    /// baseline's median ray count, which is returned too.
+    fn all(&self) -> (Vec<ConfigurationResult>, u64) {
+        let time_budget = Budget::Seconds(self.settings.time_budget.as_secs_f64());
+        let mut results: Vec<ConfigurationResult> = self
+            .settings
+            .configurations
+            .iter()
+            .map(|configuration| ConfigurationResult {
+                configuration: configuration.clone(),
+                equal_time: if configuration.is_oracle() {
+                    Vec::new()
+                } else {
+                    self.runs(configuration, time_budget, seed_of)
+                },
+                equal_rays: Vec::new(),
+            })
+            .collect();
+        let mut baseline_rays: Vec<u64> = results[0]
+            .equal_time
+            .iter()
+            .map(|r| r.rays.total())
+            .collect();
+        baseline_rays.sort_unstable();
+        let ray_budget = baseline_rays[baseline_rays.len() / 2];
+        for result in &mut results {
+            result.equal_rays = self.runs(&result.configuration, Budget::Rays(ray_budget), |s| {
+                seed_of(s) ^ 0xe0
+            });
+        }
+        (results, ray_budget)
+    }
+
+    /// Every seed of `configuration` within `budget`, seeded from `seed`.
+    fn runs(
+        &self,
+        configuration: &Configuration,
+        budget: Budget,
+        seed: impl Fn(u32) -> u64,
+    ) -> Vec<Run> {
+        let what = match budget {
+            Budget::Seconds(_) => "equal time",
+            Budget::Rays(_) => "equal rays",
+        };
+        (0..self.settings.seeds)
+            .map(|s| {
+                self.bar
+                    .set_message(format!("{} ({what}, seed {s})", configuration.name));
+                let run = progressive(
+                    self.world,
+                    configuration,
+                    self.reference,
+                    (seed(s), self.settings.pass_spp),
+                    budget,
+                );
+                self.bar.inc(1);
+                run
+            })
+            .collect()
+    }
+}
+
 /// Runs the study on `world` (its resolution as given).
 pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, String> {
     if settings.configurations.is_empty() || settings.seeds == 0 || settings.pass_spp == 0 {
@@ -348,84 +446,28 @@ pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, Stri
         settings.progress,
         "reference  [{bar:40}] {pos}/{len} spp, {elapsed} elapsed, ETA {eta}",
     );
-    let base = settings.configurations[0].settings;
-    let reference = match &settings.reference_cache {
-        Some(paths) => {
-            reference::reference(world, &base, settings.reference_spp, paths, &reference_bar)?
-        }
-        None => {
-            let key = format!("ais study {}", std::process::id());
-            let paths = reference::cache_paths(&std::env::temp_dir(), &key);
-            let result =
-                reference::reference(world, &base, settings.reference_spp, &paths, &reference_bar);
-            for path in &paths {
-                let _ = std::fs::remove_file(path);
-            }
-            result?
-        }
-    };
+    let reference = study_reference(world, settings, &reference_bar)?;
     reference_bar.finish_and_clear();
-
-    let timed: Vec<&Configuration> = settings
+    let timed = settings
         .configurations
         .iter()
         .filter(|c| !c.is_oracle())
-        .collect();
-    let runs_total = (timed.len() + settings.configurations.len()) as u64 * settings.seeds as u64;
+        .count();
     let study_bar = bar(
         &multi,
         settings.progress,
         "study      [{bar:40}] {pos}/{len} runs, {elapsed} elapsed, ETA {eta}  {msg}",
     );
-    study_bar.set_length(runs_total);
-    let seed_of = |s: u32| mix64(0xa15 ^ s as u64);
-    let budget = Budget::Seconds(settings.time_budget.as_secs_f64());
-    let mut results: Vec<ConfigurationResult> = Vec::new();
-    for configuration in &settings.configurations {
-        let mut equal_time = Vec::new();
-        if !configuration.is_oracle() {
-            for s in 0..settings.seeds {
-                study_bar.set_message(format!("{} (equal time, seed {s})", configuration.name));
-                equal_time.push(progressive(
-                    world,
-                    configuration,
-                    &reference,
-                    (seed_of(s), settings.pass_spp),
-                    budget,
-                ));
-                study_bar.inc(1);
-            }
-        }
-        results.push(ConfigurationResult {
-            configuration: configuration.clone(),
-            equal_time,
-            equal_rays: Vec::new(),
-        });
-    }
-    let mut baseline_rays: Vec<u64> = results[0]
-        .equal_time
-        .iter()
-        .map(|r| r.rays.total())
-        .collect();
-    baseline_rays.sort_unstable();
-    let ray_budget = baseline_rays[baseline_rays.len() / 2];
-    for result in &mut results {
-        for s in 0..settings.seeds {
-            study_bar.set_message(format!(
-                "{} (equal rays, seed {s})",
-                result.configuration.name
-            ));
-            result.equal_rays.push(progressive(
-                world,
-                &result.configuration,
-                &reference,
-                (seed_of(s) ^ 0xe0, settings.pass_spp),
-                Budget::Rays(ray_budget),
-            ));
-            study_bar.inc(1);
-        }
-    }
+    study_bar.set_length((timed + settings.configurations.len()) as u64 * settings.seeds as u64);
+    let runner = Runner {
+        world,
+        reference: &reference,
+        settings,
+        bar: &study_bar,
+    };
+    let (results, ray_budget) = runner.all();
     study_bar.finish_and_clear();
+    let base = settings.configurations[0].settings;
     let figure = affinity_figure::snapshots(world, &base, settings.figure_pixel, seed_of(0));
     Ok(StudyResults {
         reference,

@@ -3,7 +3,7 @@
 
 use super::affinity_figure::{snapshot_svg, SNAPSHOTS};
 use super::metrics::{relative_error_colours, rgbe};
-use super::plots::{log_log_svg, Series};
+use super::plots::{LogLogPlot, Series};
 use super::{mean_and_error, ConfigurationResult, Run, StudyResults};
 use ais_render::image_io::RgbImage;
 use base64::Engine;
@@ -74,6 +74,13 @@ fn average(runs: &[Run], value: impl Fn(&Run) -> f64) -> f64 {
 /// The summary tables as Markdown: equal time, then equal rays with the oracle's share.
 pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> String {
     let rows = rows(results, context);
+    let mut out = equal_time_table(results, context, &rows);
+    out.push_str(&equal_rays_table(results, &rows));
+    out
+}
+
+/// The equal-time table, with its introduction.
+fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row]) -> String {
     let pixels = (context.resolution.0 * context.resolution.1) as f64;
     let base = &rows[0];
     let mut out = String::new();
@@ -105,7 +112,14 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
             base.time_rel_mse.0 / row.time_rel_mse.0
         );
     }
+    out
+}
+
+/// The equal-ray table with the oracle's share, with its introduction.
+fn equal_rays_table(results: &StudyResults, rows: &[Row]) -> String {
+    let base = &rows[0];
     let oracle = rows.iter().find(|r| r.result.configuration.is_oracle());
+    let mut out = String::new();
     let _ = writeln!(
         out,
         "\nEqual rays ({:.0} rays per run, the baseline's median at equal time; relMSE × rays / \
@@ -115,7 +129,7 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
     out.push_str(
         "| configuration | spp | time (s) | relMSE | ratio | oracle share |\n|---|---|---|---|---|---|\n",
     );
-    for row in &rows {
+    for row in rows {
         let share = oracle.map_or(f64::NAN, |o| {
             (base.rays_rel_mse.0 - row.rays_rel_mse.0) / (base.rays_rel_mse.0 - o.rays_rel_mse.0)
         });
@@ -257,20 +271,22 @@ fn convergence_plots(results: &StudyResults) -> Result<(String, String), String>
             })
             .collect::<Vec<_>>()
     };
-    let time_plot = log_log_svg(
+    let plot = |title, x_label| LogLogPlot {
+        title,
+        x_label,
+        y_label: "relMSE",
+        size: (640, 400),
+    };
+    let time_plot = plot(
         "relMSE against render time (equal-time runs, seed 0)",
         "seconds",
-        "relMSE",
-        &curves(&|r| &r.equal_time, &|p| p.seconds),
-        (640, 400),
-    )?;
-    let rays_plot = log_log_svg(
+    )
+    .svg(&curves(&|r| &r.equal_time, &|p| p.seconds))?;
+    let rays_plot = plot(
         "relMSE against rays traced (equal-ray runs, seed 0)",
         "rays",
-        "relMSE",
-        &curves(&|r| &r.equal_rays, &|p| p.rays as f64),
-        (640, 400),
-    )?;
+    )
+    .svg(&curves(&|r| &r.equal_rays, &|p| p.rays as f64))?;
     Ok((time_plot, rays_plot))
 }
 

@@ -13,17 +13,39 @@ pub enum GatherTarget {
     Oracle,
 }
 
-/// Runs one batch of `n` traced rays on `scene` with `proposal`; the batch's map starts as
-/// `start` says.
-pub fn gather(
+/// A gather on an analytic scene: what every batch of it shares.
+#[derive(Clone, Copy, Debug)]
+pub struct AnalyticGather<'a> {
+    /// The scene.
+    pub scene: &'a Scene,
+    /// The proposal.
+    pub proposal: Proposal,
+    /// Rays per batch, n.
+    pub n: u32,
+    /// Whether occluded candidates are known zeros (the oracle).
+    pub target: GatherTarget,
+}
+
+impl AnalyticGather<'_> {
+    /// Runs one batch with scrambling `seed`; the batch's map starts as `start` says.
+    pub fn run(&self, batch: &mut Batch<f64>, seed: u64, start: MapStart) -> Estimate<f64> {
+        gather(batch, self, seed, start)
+    }
+}
+
+/// One batch of `job` through `batch`.
+fn gather(
     batch: &mut Batch<f64>,
-    scene: &Scene,
-    proposal: Proposal,
-    n: u32,
+    job: &AnalyticGather,
     seed: u64,
     start: MapStart,
-    target: GatherTarget,
 ) -> Estimate<f64> {
+    let AnalyticGather {
+        scene,
+        proposal,
+        n,
+        target,
+    } = *job;
     batch.begin(n, seed, start);
     while let Some(candidate) = batch.next_candidate() {
         let (direction, pdf) = proposal.sample(candidate.u);

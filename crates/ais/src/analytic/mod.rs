@@ -14,7 +14,7 @@ mod proposal;
 mod scene;
 
 pub use cap::Cap;
-pub use gather::{gather, GatherTarget};
+pub use gather::{AnalyticGather, GatherTarget};
 pub use moments::Moments;
 pub use proposal::Proposal;
 pub use scene::{Occlusion, Scene, SceneError, Sky, Sun};

@@ -1,7 +1,7 @@
 //! Helpers shared by the statistical tests: batch statistics and the chi-square test.
 #![allow(dead_code)]
 
-use ais::analytic::{gather, GatherTarget, Moments, Proposal, Scene};
+use ais::analytic::{AnalyticGather, GatherTarget, Moments, Proposal, Scene};
 use ais::{Batch, BatchConfig, MapStart};
 
 /// The sample mean, variance and mean traced rays of many independent batches.
@@ -58,19 +58,14 @@ pub fn summarize_with(
 ) -> Summary {
     let traced_before = batch.stats().traced;
     let mut moments = Moments::default();
+    let job = AnalyticGather {
+        scene,
+        proposal,
+        n,
+        target,
+    };
     for seed in 0..batches {
-        moments.add(
-            gather(
-                batch,
-                scene,
-                proposal,
-                n,
-                1_000_003 * seed as u64 + 17,
-                start,
-                target,
-            )
-            .value,
-        );
+        moments.add(job.run(batch, 1_000_003 * seed as u64 + 17, start).value);
     }
     Summary {
         mean: moments.mean(),

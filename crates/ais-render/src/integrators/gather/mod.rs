@@ -181,6 +181,19 @@ fn guided_sampler<'g>(
     }
 }
 
+/// The tile's batch driver, made on first use for `settings` (observing its rays when the
+/// gathers share maps).
+fn batch_for<'b>(
+    slot: &'b mut Option<Batch<[f32; 3]>>,
+    settings: &GatherSettings,
+) -> &'b mut Batch<[f32; 3]> {
+    slot.get_or_insert_with(|| {
+        let mut batch = Batch::new(settings.batch_config()).expect("valid gather configuration");
+        batch.observe_rays(settings.shares_maps());
+        batch
+    })
+}
+
 /// The gather: emitted radiance at the first hit of `ray` plus `n` rays of direct light
 /// through the AIS batch driver.
 pub fn gather<P: BatchProbe>(
@@ -203,11 +216,7 @@ pub fn gather<P: BatchProbe>(
     }
     let mut at = gather_point(world, &hit, -ray.direction);
     let sharing = settings.shares_maps();
-    let batch = state.batch.get_or_insert_with(|| {
-        let mut batch = Batch::new(settings.batch_config()).expect("valid gather configuration");
-        batch.observe_rays(sharing);
-        batch
-    });
+    let batch = batch_for(&mut state.batch, settings);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     let mut sampler = CandidateSampler::plain(settings.strategy);
     let start = if sharing {
