@@ -5,7 +5,7 @@
 //! everything is blocked except the caps). The integrand is diffuse direct lighting,
 //! `f(w) = L(w) · V(w) · max(0, w_z) / π`, and its integral is closed-form because the first
 //! and second moments of a spherical cap are. These scenes validate the library (tests, the
-//! study in BENCHMARKS.md, the example) and can validate a host's integration code too.
+//! study example, the gather example) and can validate a host's integration code too.
 
 mod cap;
 mod gather;

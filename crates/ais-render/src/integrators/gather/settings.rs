@@ -114,19 +114,15 @@ impl Preset {
 
     /// Its name.
     pub fn name(self) -> &'static str {
-        match self {
-            Preset::Off => "off",
-            Preset::Aggressive => "aggressive",
-            Preset::Conservative => "conservative",
-            Preset::Shared => "shared",
-            Preset::Warm => "warm",
-            Preset::Guided => "guided",
-        }
+        Self::WORDS
+            .iter()
+            .find(|(_, p)| *p == self)
+            .map_or("", |(name, _)| name)
     }
 
     /// The preset of this name.
     pub fn parse(name: &str) -> Option<Preset> {
-        Preset::ALL.into_iter().find(|p| p.name() == name)
+        Self::parse_word(name).ok()
     }
 
     fn axes(self) -> (MapSource, Update, MapUse) {
@@ -246,15 +242,78 @@ impl Default for GatherSettings {
     }
 }
 
-fn choose<T: Copy>(value: &str, what: &str, choices: &[(&str, T)]) -> Result<T, String> {
-    choices
-        .iter()
-        .find(|(name, _)| *name == value)
-        .map(|&(_, v)| v)
-        .ok_or_else(|| {
-            let names: Vec<&str> = choices.iter().map(|(name, _)| *name).collect();
-            format!("unknown {what} \"{value}\" ({})", names.join(", "))
-        })
+/// A setting written as one of a few words.
+trait Choice: Copy + PartialEq + 'static {
+    /// What the setting is called in errors.
+    const WHAT: &'static str;
+    /// Its words and values.
+    const WORDS: &'static [(&'static str, Self)];
+
+    /// The value of `word`, or an error listing the words.
+    fn parse_word(word: &str) -> Result<Self, String> {
+        Self::WORDS
+            .iter()
+            .find(|(name, _)| *name == word)
+            .map(|&(_, v)| v)
+            .ok_or_else(|| {
+                let names: Vec<&str> = Self::WORDS.iter().map(|(name, _)| *name).collect();
+                format!("unknown {} \"{word}\" ({})", Self::WHAT, names.join(", "))
+            })
+    }
+}
+
+impl Choice for RayBudget {
+    const WHAT: &'static str = "budget";
+    const WORDS: &'static [(&'static str, Self)] = &[
+        ("candidates", RayBudget::Candidates),
+        ("traced", RayBudget::Traced),
+    ];
+}
+
+impl Choice for ais::Placement {
+    const WHAT: &'static str = "placement";
+    const WORDS: &'static [(&'static str, Self)] = &[
+        ("halton", ais::Placement::Halton),
+        ("random", ais::Placement::Random),
+    ];
+}
+
+impl Choice for MapSource {
+    const WHAT: &'static str = "map";
+    const WORDS: &'static [(&'static str, Self)] = &[
+        ("none", MapSource::None),
+        ("batch", MapSource::Batch),
+        ("neighbours", MapSource::Neighbours),
+    ];
+}
+
+impl Choice for Update {
+    const WHAT: &'static str = "update";
+    const WORDS: &'static [(&'static str, Self)] = &[
+        ("off", Update::Off),
+        ("aggressive", Update::Aggressive),
+        ("conservative", Update::Conservative),
+    ];
+}
+
+impl Choice for MapUse {
+    const WHAT: &'static str = "map_use";
+    const WORDS: &'static [(&'static str, Self)] = &[
+        ("roulette", MapUse::Roulette),
+        ("proposal", MapUse::Proposal),
+    ];
+}
+
+impl Choice for Preset {
+    const WHAT: &'static str = "AIS preset";
+    const WORDS: &'static [(&'static str, Self)] = &[
+        ("off", Preset::Off),
+        ("aggressive", Preset::Aggressive),
+        ("conservative", Preset::Conservative),
+        ("shared", Preset::Shared),
+        ("warm", Preset::Warm),
+        ("guided", Preset::Guided),
+    ];
 }
 
 fn number<T: std::str::FromStr>(value: &str, what: &str) -> Result<T, String> {
@@ -297,26 +356,9 @@ impl GatherSettings {
                 })?
             }
             "rays" => self.rays = number(value, "rays")?,
-            "budget" => {
-                use RayBudget::*;
-                self.budget = choose(
-                    value,
-                    "budget",
-                    &[("candidates", Candidates), ("traced", Traced)],
-                )?
-            }
-            "placement" => {
-                use ais::Placement::*;
-                self.placement = choose(
-                    value,
-                    "placement",
-                    &[("halton", Halton), ("random", Random)],
-                )?
-            }
-            "ais" => {
-                let presets = Preset::ALL.map(|p| (p.name(), p));
-                *self = self.with_preset(choose(value, "AIS preset", &presets)?)
-            }
+            "budget" => self.budget = Choice::parse_word(value)?,
+            "placement" => self.placement = Choice::parse_word(value)?,
+            "ais" => *self = self.with_preset(Choice::parse_word(value)?),
             _ => return self.set_map_parameter(name, value),
         }
         Ok(())
@@ -325,34 +367,9 @@ impl GatherSettings {
     /// [`GatherSettings::set`] for the map's parameters.
     fn set_map_parameter(&mut self, name: &str, value: &str) -> Result<(), String> {
         match name {
-            "map" => {
-                use MapSource::*;
-                self.map = choose(
-                    value,
-                    "map",
-                    &[("none", None), ("batch", Batch), ("neighbours", Neighbours)],
-                )?
-            }
-            "update" => {
-                use Update::*;
-                self.update = choose(
-                    value,
-                    "update",
-                    &[
-                        ("off", Off),
-                        ("aggressive", Aggressive),
-                        ("conservative", Conservative),
-                    ],
-                )?
-            }
-            "map_use" => {
-                use MapUse::*;
-                self.map_use = choose(
-                    value,
-                    "map_use",
-                    &[("roulette", Roulette), ("proposal", Proposal)],
-                )?
-            }
+            "map" => self.map = Choice::parse_word(value)?,
+            "update" => self.update = Choice::parse_word(value)?,
+            "map_use" => self.map_use = Choice::parse_word(value)?,
             "acceptance" => {
                 self.acceptance = Acceptance::parse(value).ok_or_else(|| {
                     format!("unknown acceptance \"{value}\" (affinity, sqrt, value, efficient)")
