@@ -9,6 +9,7 @@ use std::process::ExitCode;
 mod bench_command;
 mod compare;
 mod gather_flags;
+mod limits;
 mod render_command;
 
 /// Adaptive importance sampling for multi-ray gathering: a renderer for studying it.
@@ -53,9 +54,7 @@ fn parse_define(text: &str) -> Result<(String, String), String> {
 /// Starts `threads` rayon workers (None: one per core).
 fn start_threads(threads: Option<usize>) -> Result<(), String> {
     if let Some(threads) = threads {
-        if threads == 0 {
-            return Err("--threads must be at least 1".into());
-        }
+        limits::check_threads(threads)?;
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build_global()
@@ -78,10 +77,12 @@ fn load_world(
             if let Some(resolution) = resolution {
                 description.resolution = resolution;
             }
+            limits::check_image_memory(description.resolution)?;
             World::from_description(description).map_err(|e| e.to_string())?
         }
         None => {
             let (width, height) = resolution.unwrap_or(default_resolution);
+            limits::check_image_memory((width, height))?;
             default_world(width, height)
         }
     };

@@ -2,7 +2,8 @@
 
 use crate::gather_flags::GatherFlags;
 use crate::{load_world, parse_define, parse_resolution, start_threads};
-use ais_render::image_io::{write_exr, write_png, RgbImage};
+use ais_render::atomic_write::OutputSet;
+use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
 use ais_render::integrators::gather::GatherStats;
 use ais_render::integrators::{AmbientOcclusion, Integrator};
 use ais_render::render::{render, RenderOutput, RenderSettings};
@@ -11,7 +12,7 @@ use ais_study::oracle::Oracle;
 use ais_study::timing::{TimedGather, SAMPLING};
 use clap::ValueEnum;
 use std::io::IsTerminal;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::time::Duration;
 
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -175,13 +176,70 @@ fn run_integrator(
     }
 }
 
-/// Writes the image, the AOV and the preview.
+/// Checks, before any work, that the outputs can be written: an `.exr` path in an existing
+/// folder, not a folder itself, and an AOV that is an `.exr` of its own.
+fn check_outputs(args: &RenderArgs) -> Result<(), String> {
+    let exr = |path: &Path, flag: &str| -> Result<(), String> {
+        let extension = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase);
+        if extension.as_deref() != Some("exr") {
+            return Err(format!("{}: {flag} must be an .exr file", path.display()));
+        }
+        if path.is_dir() {
+            return Err(format!(
+                "{}: {flag} is a folder, not a file",
+                path.display()
+            ));
+        }
+        let folder = match path.parent() {
+            Some(folder) if !folder.as_os_str().is_empty() => folder,
+            _ => Path::new("."),
+        };
+        if !folder.is_dir() {
+            return Err(format!(
+                "{}: the folder {} does not exist",
+                path.display(),
+                folder.display()
+            ));
+        }
+        Ok(())
+    };
+    exr(&args.output, "the output")?;
+    if let Some(aov) = &args.aov_traced {
+        exr(aov, "--aov-traced")?;
+        let preview = args.output.with_extension("png");
+        if same_file(aov, &args.output) || same_file(aov, &preview) {
+            return Err(format!(
+                "{}: --aov-traced would overwrite the image; give it another name",
+                aov.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Whether two paths name the same file (as written, or once resolved if both exist).
+fn same_file(a: &Path, b: &Path) -> bool {
+    let absolute = |p: &Path| std::path::absolute(p).unwrap_or_else(|_| p.to_path_buf());
+    absolute(a) == absolute(b)
+        || matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y)
+}
+
+/// Writes the image, the AOV and the preview as a unit: all of them, or none.
 fn write_outputs(
     args: &RenderArgs,
     world: &World,
     output: &RenderOutput<GatherStats>,
 ) -> Result<(), String> {
-    write_exr(&args.output, &output.image).map_err(|e| e.to_string())?;
+    let mut outputs = OutputSet::default();
+    let failed = |e: WriteError| e.to_string();
+    outputs
+        .stage(&args.output, |file| {
+            encode_exr(file, &output.image, &args.output)
+        })
+        .map_err(failed)?;
     if let Some(path) = &args.aov_traced {
         let (width, height) = world.resolution;
         let aov = RgbImage {
@@ -189,29 +247,25 @@ fn write_outputs(
             height: height as usize,
             pixels: output.work_per_sample.iter().map(|&t| [t; 3]).collect(),
         };
-        write_exr(path, &aov).map_err(|e| e.to_string())?;
+        outputs
+            .stage(path, |file| encode_exr(file, &aov, path))
+            .map_err(failed)?;
     }
     if !args.no_preview {
         let preview = args.output.with_extension("png");
-        write_png(&preview, &output.image, args.exposure).map_err(|e| e.to_string())?;
+        outputs
+            .stage(&preview, |file| {
+                encode_png(file, &output.image, args.exposure, &preview)
+            })
+            .map_err(failed)?;
     }
-    Ok(())
+    outputs.commit().map_err(|e| e.to_string())
 }
 
 /// `ais render`.
 pub fn run(args: RenderArgs) -> Result<(), String> {
     start_threads(args.threads)?;
-    let extension = args
-        .output
-        .extension()
-        .and_then(|e| e.to_str())
-        .map(str::to_ascii_lowercase);
-    if extension.as_deref() != Some("exr") {
-        return Err(format!(
-            "{}: the output must be an .exr file",
-            args.output.display()
-        ));
-    }
+    check_outputs(&args)?;
     let world = load_world(
         args.scene.as_deref(),
         &args.define,

@@ -33,9 +33,79 @@ pub fn write_atomically<E: From<io::Error>>(
     }
 }
 
+/// Outputs written as a unit: each is written to a temporary file beside its target, and
+/// only when every one has been written are they all renamed over their targets. Dropped
+/// without [`OutputSet::commit`], it removes its temporary files and leaves the targets as
+/// they were.
+#[derive(Debug, Default)]
+pub struct OutputSet {
+    /// (temporary, target) of every staged output.
+    staged: Vec<(PathBuf, PathBuf)>,
+}
+
+impl OutputSet {
+    /// Writes `target`'s content to its temporary file with `write`.
+    pub fn stage<E>(
+        &mut self,
+        target: &Path,
+        write: impl FnOnce(&Path) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let temporary = temporary_path(target);
+        self.staged.push((temporary.clone(), target.to_path_buf()));
+        write(&temporary)
+    }
+
+    /// Renames every staged output over its target.
+    pub fn commit(mut self) -> io::Result<()> {
+        for (temporary, target) in std::mem::take(&mut self.staged) {
+            std::fs::rename(&temporary, &target).map_err(|e| {
+                io::Error::new(e.kind(), format!("{}: cannot write: {e}", target.display()))
+            })?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for OutputSet {
+    fn drop(&mut self) {
+        for (temporary, _) in &self.staged {
+            let _ = std::fs::remove_file(temporary);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn outputs_are_replaced_together_or_not_at_all() {
+        let dir = std::env::temp_dir().join(format!("ais-output-set-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (a, b) = (dir.join("a.txt"), dir.join("b.txt"));
+        std::fs::write(&a, "old a").unwrap();
+        std::fs::write(&b, "old b").unwrap();
+        let mut set = OutputSet::default();
+        set.stage::<io::Error>(&a, |tmp| std::fs::write(tmp, "new a"))
+            .unwrap();
+        let failed: Result<(), io::Error> = set.stage(&b, |_| Err(io::Error::other("no space")));
+        assert!(failed.is_err());
+        drop(set);
+        assert_eq!(std::fs::read_to_string(&a).unwrap(), "old a");
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            2,
+            "no temporary left"
+        );
+        let mut set = OutputSet::default();
+        set.stage::<io::Error>(&a, |tmp| std::fs::write(tmp, "new a"))
+            .unwrap();
+        set.stage::<io::Error>(&b, |tmp| std::fs::write(tmp, "new b"))
+            .unwrap();
+        set.commit().unwrap();
+        assert_eq!(std::fs::read_to_string(&b).unwrap(), "new b");
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn failed_write_keeps_the_old_file() {

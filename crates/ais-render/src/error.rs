@@ -43,3 +43,40 @@ impl fmt::Display for InputError {
 }
 
 impl std::error::Error for InputError {}
+
+/// The largest mesh or image file a scene may refer to, in bytes.
+pub const LARGEST_INPUT_FILE: u64 = 4 << 30;
+
+/// Checks that `path` names a regular file of at most [`LARGEST_INPUT_FILE`] bytes (`what`
+/// says what it should hold, for the error): a device such as `/dev/zero` or a folder would
+/// be read until memory runs out, or fail with a bare system error.
+pub fn check_input_file(path: &Path, what: &str) -> Result<(), InputError> {
+    let metadata = match std::fs::metadata(path) {
+        Ok(metadata) => metadata,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(InputError::new(path, format!("{what} not found")))
+        }
+        Err(e) => {
+            return Err(InputError::new(
+                path,
+                format!("cannot read the {what}: {e}"),
+            ))
+        }
+    };
+    if !metadata.is_file() {
+        return Err(InputError::new(
+            path,
+            format!("the {what} is not a regular file"),
+        ));
+    }
+    if metadata.len() > LARGEST_INPUT_FILE {
+        return Err(InputError::new(
+            path,
+            format!(
+                "the {what} has {} bytes, more than the {LARGEST_INPUT_FILE} ais reads",
+                metadata.len()
+            ),
+        ));
+    }
+    Ok(())
+}

@@ -50,9 +50,7 @@ impl RgbImage {
 
 /// Reads an `.exr` or `.hdr` file into linear RGB, sanitising bad texels.
 pub fn read_image(path: &Path) -> Result<LoadedImage, InputError> {
-    if !path.exists() {
-        return Err(InputError::new(path, "image file not found"));
-    }
+    crate::error::check_input_file(path, "image file")?;
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
@@ -124,6 +122,13 @@ impl std::error::Error for WriteError {}
 
 /// Writes 32-bit float RGB EXR atomically. Refuses images with non-finite pixels.
 pub fn write_exr(path: &Path, image: &RgbImage) -> Result<(), WriteError> {
+    write_atomically(path, |temporary| encode_exr(temporary, image, path))
+}
+
+/// Writes 32-bit float RGB EXR to `file` (errors name `target`, the file it stands for).
+/// Chunks are compressed in order on one thread, so the same image always gives the same
+/// bytes. Refuses images with non-finite pixels.
+pub fn encode_exr(file: &Path, image: &RgbImage, target: &Path) -> Result<(), WriteError> {
     if let Some(index) = image
         .pixels
         .iter()
@@ -131,18 +136,21 @@ pub fn write_exr(path: &Path, image: &RgbImage) -> Result<(), WriteError> {
     {
         return Err(WriteError(format!(
             "{}: pixel ({}, {}) is not finite; refusing to write",
-            path.display(),
+            target.display(),
             index % image.width,
             index / image.width
         )));
     }
-    write_atomically(path, |temporary| {
-        exr::prelude::write_rgb_file(temporary, image.width, image.height, |x, y| {
-            let p = image.pixels[y * image.width + x];
-            (p[0], p[1], p[2])
-        })
-        .map_err(|e| WriteError(format!("{}: cannot write EXR: {e}", path.display())))
-    })
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|Vec2(x, y)| {
+        let p: [f32; 3] = image.pixels[y * image.width + x];
+        (p[0], p[1], p[2])
+    });
+    Image::from_channels((image.width, image.height), channels)
+        .write()
+        .non_parallel()
+        .to_file(file)
+        .map_err(|e| WriteError(format!("{}: cannot write EXR: {e}", target.display())))
 }
 
 /// The sRGB transfer function of a linear value in [0, 1].
@@ -156,21 +164,32 @@ fn srgb_encode(linear: f32) -> f32 {
 
 /// Writes an 8-bit sRGB PNG preview atomically: pixels scaled by 2^`exposure`, clamped.
 pub fn write_png(path: &Path, image: &RgbImage, exposure: f32) -> Result<(), WriteError> {
+    write_atomically(path, |temporary| {
+        encode_png(temporary, image, exposure, path)
+    })
+}
+
+/// Writes an 8-bit sRGB PNG preview to `file` (errors name `target`, the file it stands
+/// for): pixels scaled by 2^`exposure`, clamped.
+pub fn encode_png(
+    file: &Path,
+    image: &RgbImage,
+    exposure: f32,
+    target: &Path,
+) -> Result<(), WriteError> {
     let scale = exposure.exp2();
     let bytes: Vec<u8> = image
         .pixels
         .iter()
         .flat_map(|p| p.map(|c| (srgb_encode((c * scale).clamp(0.0, 1.0)) * 255.0 + 0.5) as u8))
         .collect();
-    write_atomically(path, |temporary| {
-        image::save_buffer_with_format(
-            temporary,
-            &bytes,
-            image.width as u32,
-            image.height as u32,
-            image::ExtendedColorType::Rgb8,
-            image::ImageFormat::Png,
-        )
-        .map_err(|e| WriteError(format!("{}: cannot write PNG: {e}", path.display())))
-    })
+    image::save_buffer_with_format(
+        file,
+        &bytes,
+        image.width as u32,
+        image.height as u32,
+        image::ExtendedColorType::Rgb8,
+        image::ImageFormat::Png,
+    )
+    .map_err(|e| WriteError(format!("{}: cannot write PNG: {e}", target.display())))
 }

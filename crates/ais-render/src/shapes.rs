@@ -85,10 +85,23 @@ pub fn sphere(
             "a sphere's to_world must scale uniformly",
         ));
     }
-    Ok(ShapeGeometry::Sphere(Sphere {
+    let sphere = Sphere {
         center: to_world.transform_point3(center).as_vec3(),
         radius: (radius * scales[0]) as f32,
-    }))
+    };
+    let extent = sphere.center.abs().max_element() + sphere.radius;
+    if !(extent.is_finite() && extent <= crate::mesh::LARGEST_COORDINATE) {
+        return Err(InputError::at(
+            file,
+            line,
+            format!(
+                "the sphere reaches {extent:e}, beyond ±{:e}: coordinates this large break the \
+                 BVH's precision; scale the scene down",
+                crate::mesh::LARGEST_COORDINATE
+            ),
+        ));
+    }
+    Ok(ShapeGeometry::Sphere(sphere))
 }
 
 #[cfg(test)]

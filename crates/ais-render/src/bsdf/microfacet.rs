@@ -55,7 +55,10 @@ impl Microfacet {
         let cos2 = h.z * h.z;
         match self.kind {
             MicrofacetKind::Ggx => {
-                let denominator = (a2 - 1.0) * cos2 + 1.0;
+                // (α² − 1) cos² + 1, written as sin² + α² cos²: in f32, α² − 1 rounds to −1
+                // for α below about 2.4e-4, and the denominator would vanish at the peak.
+                let sin2 = h.x * h.x + h.y * h.y;
+                let denominator = sin2 + a2 * cos2;
                 a2 / (PI * denominator * denominator)
             }
             MicrofacetKind::Beckmann => {

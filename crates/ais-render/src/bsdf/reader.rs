@@ -48,9 +48,16 @@ fn index_of_refraction(
                 default
             }
         },
+        Some(Property::Float(v)) => {
+            warn(format!(
+                "\"{name}\" = {v} must be positive; using {default}"
+            ));
+            default
+        }
         Some(other) => {
             warn(format!(
-                "\"{name}\" must be a positive float or a material name, not {other:?}; using {default}"
+                "\"{name}\" must be a positive float or a material name, not a {}; using {default}",
+                other.kind()
             ));
             default
         }
@@ -160,7 +167,19 @@ impl BsdfReader<'_> {
                 MicrofacetKind::Beckmann
             }
         };
-        Microfacet::new(kind, plugin.float("alpha", 0.1).unwrap_or(0.1) as f32)
+        let alpha = match plugin.float("alpha", 0.1) {
+            Ok(alpha) if alpha.is_finite() && alpha >= 0.0 => alpha,
+            Ok(alpha) => {
+                self.warn(format!("alpha = {alpha} must be a number ≥ 0; using 0.1"));
+                0.1
+            }
+            Err((_, message)) => {
+                self.warn(format!("{message}; using alpha = 0.1"));
+                0.1
+            }
+        };
+        // As in Mitsuba, roughness is at least 1e-4 (and at most 1 here).
+        Microfacet::new(kind, alpha as f32)
     }
 
     /// A conductor's complex index of refraction: `eta` and `k`, or a named `material`.

@@ -31,9 +31,7 @@ pub struct LoadedMesh {
 
 /// Reads a mesh file of the given format.
 pub fn load_mesh(path: &Path, format: MeshFormat) -> Result<LoadedMesh, InputError> {
-    if !path.exists() {
-        return Err(InputError::new(path, "mesh file not found"));
-    }
+    crate::error::check_input_file(path, "mesh file")?;
     let mesh = match format {
         MeshFormat::Obj => obj::read(path)?,
         MeshFormat::Ply => ply::read(path)?,
@@ -42,14 +40,33 @@ pub fn load_mesh(path: &Path, format: MeshFormat) -> Result<LoadedMesh, InputErr
     validate(path, mesh)
 }
 
-/// Checks a mesh: positions finite, indices in range, normals usable; degenerate triangles
-/// (zero area) are dropped with a warning; an empty result is an error.
+/// The largest coordinate a scene may use, in world units: beyond it the BVH's single
+/// precision bounds lose every digit of a typical triangle.
+pub const LARGEST_COORDINATE: f32 = 1e12;
+
+/// Checks a mesh: positions finite and within ±[`LARGEST_COORDINATE`], indices in range,
+/// normals usable; degenerate triangles (zero area) are dropped with a warning; an empty
+/// result is an error.
 pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, InputError> {
     let mut warnings = Vec::new();
     if let Some(index) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(InputError::new(
             path,
             format!("vertex {index} has a non-finite position"),
+        ));
+    }
+    if let Some(index) = mesh
+        .positions
+        .iter()
+        .position(|p| p.abs().max_element() > LARGEST_COORDINATE)
+    {
+        return Err(InputError::new(
+            path,
+            format!(
+                "vertex {index} lies at {}, beyond ±{LARGEST_COORDINATE:e}: coordinates this \
+                 large break the BVH's precision; scale the scene down",
+                mesh.positions[index]
+            ),
         ));
     }
     let count = mesh.positions.len() as u32;

@@ -115,6 +115,7 @@ pub fn load_scene(
     path: &Path,
     overrides: &[(String, String)],
 ) -> Result<SceneDescription, InputError> {
+    crate::error::check_input_file(path, "scene file")?;
     let text = std::fs::read_to_string(path)
         .map_err(|e| InputError::new(path, format!("cannot read the scene: {e}")))?;
     parse_scene(path, &text, overrides)

@@ -23,6 +23,9 @@ const PLUGIN_TAGS: &[&str] = &[
 /// Tags of Mitsuba that this reader refuses with a clear error rather than ignore.
 const UNSUPPORTED_TAGS: &[&str] = &["medium", "phase", "volume", "spectrum", "include", "alias"];
 
+/// The deepest nesting of plugins a scene may use (Mitsuba's scenes nest a handful).
+pub const DEEPEST_NESTING: usize = 64;
+
 /// The children of the root `<scene>`, after substitution.
 pub struct ParsedScene {
     /// Top-level plugins, in file order.
@@ -83,7 +86,7 @@ pub fn parse(
             continue;
         }
         if PLUGIN_TAGS.contains(&tag) {
-            plugins.push(reader.plugin(child)?);
+            plugins.push(reader.plugin(child, 1)?);
         } else if tag == "ref" {
             return Err(reader.error(child, "a <ref> at scene level refers to nothing"));
         } else {
@@ -171,7 +174,14 @@ impl<'a> Reader<'a> {
         Ok(out)
     }
 
-    fn plugin(&mut self, node: roxmltree::Node) -> Result<Plugin, InputError> {
+    /// The plugin element `node`, nested `depth` plugins deep (at most [`DEEPEST_NESTING`]).
+    fn plugin(&mut self, node: roxmltree::Node, depth: usize) -> Result<Plugin, InputError> {
+        if depth > DEEPEST_NESTING {
+            return Err(self.error(
+                node,
+                format!("plugins are nested more than {DEEPEST_NESTING} deep"),
+            ));
+        }
         let tag = node.tag_name().name().to_string();
         let kind = self.attribute(node, "type")?;
         let mut plugin = Plugin {
@@ -187,7 +197,7 @@ impl<'a> Reader<'a> {
         for child in node.children().filter(|n| n.is_element()) {
             let child_tag = child.tag_name().name();
             if PLUGIN_TAGS.contains(&child_tag) {
-                plugin.children.push(self.plugin(child)?);
+                plugin.children.push(self.plugin(child, depth + 1)?);
             } else if child_tag == "ref" {
                 let id = self.attribute(child, "id")?;
                 let name = self.optional_attribute(child, "name")?;

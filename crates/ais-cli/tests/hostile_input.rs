@@ -1,0 +1,183 @@
+//! Hostile and absurd input: each case ends in a clear error naming what is wrong (or, where
+//! the input is legal, a finished render), never a panic, an abort or a hang.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("hostile-{name}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn ais(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_ais"))
+        .args(args)
+        .output()
+        .expect("ais runs")
+}
+
+/// Runs `ais args` and checks that it fails with a message containing `expected`.
+fn refused(args: &[&str], expected: &str) {
+    let output = ais(args);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(!stderr.contains("panicked"), "{args:?} panicked: {stderr}");
+    assert_eq!(output.status.code(), Some(1), "{args:?}: {stderr}");
+    assert!(
+        stderr.contains(expected),
+        "{args:?}: expected {expected:?} in {stderr}"
+    );
+}
+
+/// A scene with a constant sky, a camera and `body`.
+fn scene(dir: &Path, body: &str) -> String {
+    let text = format!(
+        r#"<scene version="3.0.0"><sensor type="perspective"><transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform><film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film></sensor><emitter type="constant"><rgb name="radiance" value="1"/></emitter>{body}</scene>"#
+    );
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, text).unwrap();
+    path.to_string_lossy().into_owned()
+}
+
+#[test]
+fn huge_coordinates_are_refused_before_the_bvh() {
+    let dir = scratch("huge");
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    let rectangle = scene(
+        &dir,
+        r#"<shape type="rectangle"><transform name="to_world"><scale value="1e20"/></transform></shape>"#,
+    );
+    refused(&["render", &rectangle, "-o", out], "beyond ±1e12");
+    let sphere = scene(
+        &dir,
+        r#"<shape type="sphere"><float name="radius" value="1e20"/></shape>"#,
+    );
+    refused(&["render", &sphere, "-o", out], "beyond ±1e12");
+    std::fs::write(
+        dir.join("far.obj"),
+        "v 0 0 0\nv 1e20 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let obj = scene(
+        &dir,
+        r#"<shape type="obj"><string name="filename" value="far.obj"/></shape>"#,
+    );
+    refused(&["render", &obj, "-o", out], "beyond ±1e12");
+}
+
+#[test]
+fn absurd_sizes_are_refused_before_work_starts() {
+    let dir = scratch("sizes");
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    refused(
+        &[
+            "render",
+            "--map-res",
+            "46341",
+            "--ais",
+            "aggressive",
+            "-o",
+            out,
+        ],
+        "map_res must lie in",
+    );
+    refused(&["render", "--rays", "4294967295", "-o", out], "rays");
+    refused(&["render", "--threads", "10000", "-o", out], "per core");
+    refused(&["render", "--resolution", "65536x65536", "-o", out], "GiB");
+    let rays = scene(
+        &dir,
+        r#"<integrator type="gather"><integer name="rays" value="99999999999"/></integrator><shape type="sphere"/>"#,
+    );
+    refused(&["render", &rays, "-o", out], "scene.xml:1:");
+}
+
+#[test]
+fn deep_nesting_and_endless_files_are_refused() {
+    let dir = scratch("deep");
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    let depth = 10_000;
+    let nested = format!(
+        r#"<shape type="sphere">{}<bsdf type="diffuse"/>{}</shape>"#,
+        r#"<bsdf type="twosided">"#.repeat(depth),
+        "</bsdf>".repeat(depth)
+    );
+    refused(
+        &["render", &scene(&dir, &nested), "-o", out],
+        "nested more than",
+    );
+    if Path::new("/dev/zero").exists() {
+        let endless = scene(
+            &dir,
+            r#"<shape type="obj"><string name="filename" value="/dev/zero"/></shape>"#,
+        );
+        refused(&["render", &endless, "-o", out], "not a regular file");
+        refused(&["render", "/dev/zero", "-o", out], "not a regular file");
+    }
+}
+
+#[test]
+fn smooth_microfacets_render_and_bad_roughness_warns() {
+    let dir = scratch("alpha");
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    for (alpha, warns) in [("1e-4", false), ("0", false), ("nan", true), ("-0.3", true)] {
+        for bsdf in ["roughplastic", "roughconductor"] {
+            let body = format!(
+                r#"<shape type="sphere"><bsdf type="{bsdf}"><string name="distribution" value="ggx"/><float name="alpha" value="{alpha}"/></bsdf></shape>"#
+            );
+            let output = ais(&["render", &scene(&dir, &body), "-o", out, "--quiet"]);
+            let stderr = String::from_utf8_lossy(&output.stderr);
+            assert!(output.status.success(), "{bsdf} alpha {alpha}: {stderr}");
+            assert_eq!(
+                stderr.contains("alpha"),
+                warns,
+                "{bsdf} alpha {alpha}: {stderr}"
+            );
+        }
+    }
+}
+
+#[test]
+fn outputs_are_checked_first_and_written_as_a_unit() {
+    let dir = scratch("outputs");
+    let out = dir.join("a.exr");
+    let out = out.to_str().unwrap();
+    fn with<'a>(extra: &[&'a str]) -> Vec<&'a str> {
+        let small = ["render", "--resolution", "16x9", "--spp", "1", "--quiet"];
+        [&small[..], extra].concat()
+    }
+    refused(
+        &with(&["-o", out, "--aov-traced", out]),
+        "would overwrite the image",
+    );
+    refused(
+        &with(&["-o", out, "--aov-traced", "x.txt"]),
+        "must be an .exr",
+    );
+    let missing = dir.join("no/such/folder/a.exr");
+    refused(&with(&["-o", missing.to_str().unwrap()]), "does not exist");
+    let folder = dir.join("folder.exr");
+    std::fs::create_dir_all(&folder).unwrap();
+    refused(&with(&["-o", folder.to_str().unwrap()]), "is a folder");
+    // The same render writes the same bytes, at any thread count.
+    let bytes = |threads: &str| {
+        let output = ais(&with(&["-o", out, "--threads", threads]));
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        std::fs::read(out).unwrap()
+    };
+    assert_eq!(bytes("1"), bytes("2"), "EXR bytes differ between runs");
+    let left: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().ends_with(".tmp"))
+        .collect();
+    assert!(left.is_empty(), "temporary files left: {left:?}");
+}
