@@ -1,7 +1,7 @@
 //! `ais compare`: a study of gather configurations on one scene, with an HTML report.
 
 use crate::gather_flags::{configuration, GatherFlags};
-use crate::{load_world, parse_define, parse_resolution, start_threads};
+use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Strategy};
 use ais_study::compare::report::{self, ReportContext};
 use ais_study::compare::{reference, talk_configurations, Configuration, StudySettings};
@@ -60,6 +60,9 @@ pub struct CompareArgs {
     /// Set a scene $parameter: -D name=value (repeatable).
     #[arg(short = 'D', value_parser = parse_define)]
     define: Vec<(String, String)>,
+    /// Treat every warning about the scene as an error.
+    #[arg(long)]
+    strict: bool,
 }
 
 fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
@@ -180,12 +183,13 @@ fn check_arguments(args: &CompareArgs) -> Result<(), String> {
 pub fn run(args: CompareArgs) -> Result<(), String> {
     start_threads(args.threads)?;
     check_arguments(&args)?;
-    let world = load_world(
-        args.scene.as_deref(),
-        &args.define,
-        args.resolution,
-        (320, 180),
-    )?;
+    let world = load_world(&SceneRequest {
+        scene: args.scene.as_deref(),
+        defines: &args.define,
+        resolution: args.resolution,
+        default_resolution: (320, 180),
+        strict: args.strict,
+    })?;
     let base = args.gather.settings(
         &world.description.file,
         world.description.integrator.as_ref(),

@@ -63,31 +63,52 @@ fn start_threads(threads: Option<usize>) -> Result<(), String> {
     Ok(())
 }
 
-/// The scene file's world (resolution overridden if given), or the built-in default scene at
-/// `resolution` or `default_resolution`; prints the scene's warnings.
-fn load_world(
-    scene: Option<&std::path::Path>,
-    defines: &[(String, String)],
+/// What `render` and `compare` ask to load.
+struct SceneRequest<'a> {
+    /// The scene file, or None for the built-in default scene.
+    scene: Option<&'a std::path::Path>,
+    /// `-D name=value` parameters.
+    defines: &'a [(String, String)],
+    /// `--resolution`, if given.
     resolution: Option<(u32, u32)>,
+    /// The built-in scene's size without `--resolution`.
     default_resolution: (u32, u32),
-) -> Result<World, String> {
-    let world = match scene {
+    /// Whether warnings are errors (`--strict`).
+    strict: bool,
+}
+
+/// The scene file's world (resolution overridden if given), or the built-in default scene;
+/// prints the scene's warnings, or refuses the scene for them with `--strict`.
+fn load_world(request: &SceneRequest) -> Result<World, String> {
+    let world = match request.scene {
         Some(path) => {
-            let mut description = load_scene(path, defines).map_err(|e| e.to_string())?;
-            if let Some(resolution) = resolution {
+            let mut description = load_scene(path, request.defines).map_err(|e| e.to_string())?;
+            if let Some(resolution) = request.resolution {
                 description.resolution = resolution;
             }
             limits::check_image_memory(description.resolution)?;
             World::from_description(description).map_err(|e| e.to_string())?
         }
         None => {
-            let (width, height) = resolution.unwrap_or(default_resolution);
+            let (width, height) = request.resolution.unwrap_or(request.default_resolution);
             limits::check_image_memory((width, height))?;
-            default_world(width, height)
+            let mut world = default_world(width, height);
+            world
+                .warnings
+                .extend(request.defines.iter().map(|(name, value)| {
+                    format!("-D {name}={value} is not used: the built-in scene has no parameters")
+                }));
+            world
         }
     };
     for warning in &world.warnings {
         eprintln!("warning: {warning}");
+    }
+    if request.strict && !world.warnings.is_empty() {
+        return Err(format!(
+            "{} warning(s) above, and --strict makes them errors",
+            world.warnings.len()
+        ));
     }
     Ok(world)
 }

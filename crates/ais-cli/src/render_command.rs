@@ -1,7 +1,7 @@
 //! `ais render`: render a scene (or the built-in default scene) to EXR and a PNG preview.
 
 use crate::gather_flags::GatherFlags;
-use crate::{load_world, parse_define, parse_resolution, start_threads};
+use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest};
 use ais_render::atomic_write::OutputSet;
 use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
 use ais_render::integrators::gather::GatherStats;
@@ -77,6 +77,9 @@ pub struct RenderArgs {
     /// Set a scene $parameter: -D name=value (repeatable).
     #[arg(short = 'D', value_parser = parse_define)]
     define: Vec<(String, String)>,
+    /// Treat every warning about the scene as an error.
+    #[arg(long)]
+    strict: bool,
 }
 
 /// What a render produced, whatever integrator made it.
@@ -266,12 +269,13 @@ fn write_outputs(
 pub fn run(args: RenderArgs) -> Result<(), String> {
     start_threads(args.threads)?;
     check_outputs(&args)?;
-    let world = load_world(
-        args.scene.as_deref(),
-        &args.define,
-        args.resolution,
-        (640, 360),
-    )?;
+    let world = load_world(&SceneRequest {
+        scene: args.scene.as_deref(),
+        defines: &args.define,
+        resolution: args.resolution,
+        default_resolution: (640, 360),
+        strict: args.strict,
+    })?;
     let integrator = integrator(&args, &world)?;
     let samples_per_pixel = args.spp.unwrap_or(world.sample_count);
     if samples_per_pixel == 0 {

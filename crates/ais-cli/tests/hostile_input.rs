@@ -181,3 +181,92 @@ fn outputs_are_checked_first_and_written_as_a_unit() {
         .collect();
     assert!(left.is_empty(), "temporary files left: {left:?}");
 }
+
+#[test]
+fn bsdf_references_resolve_and_bad_ones_are_errors() {
+    let dir = scratch("references");
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    let green = scene(
+        &dir,
+        r#"<bsdf type="diffuse" id="green"><rgb name="reflectance" value="0,0.5,0"/></bsdf><shape type="sphere"><bsdf type="twosided"><ref id="green"/></bsdf></shape>"#,
+    );
+    let output = ais(&["render", &green, "-o", out, "--quiet", "--strict"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+    let missing = scene(
+        &dir,
+        r#"<shape type="sphere"><bsdf type="twosided"><ref id="nosuch"/></bsdf></shape>"#,
+    );
+    refused(
+        &["render", &missing, "-o", out],
+        r#"no <bsdf> with id "nosuch""#,
+    );
+    let cycle = scene(
+        &dir,
+        r#"<bsdf type="twosided" id="loop"><ref id="loop"/></bsdf><shape type="sphere"><ref id="loop"/></shape>"#,
+    );
+    refused(&["render", &cycle, "-o", out], "a cycle of references");
+    let twice = scene(
+        &dir,
+        r#"<shape type="sphere" id="x"/><shape type="sphere" id="x"/>"#,
+    );
+    refused(&["render", &twice, "-o", out], r#"id "x" is already used"#);
+}
+
+#[test]
+fn every_unread_input_is_named_and_strict_refuses_it() {
+    let dir = scratch("unread");
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    let text = r#"<scene version="3.0.0"><default name="a" value="1"/><default name="a" value="2"/>
+<sensor type="perspective"><transform name="to_world"><lookat origin="0,0,4" target="0,0,0" up="0,1,0"/></transform>
+<film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><string name="component_format" value="float16"/></film>
+<sampler type="independent"><integer name="sample_cont" value="8"/></sampler></sensor>
+<emitter type="constant" foo="bar"><float name="scael" value="2"/></emitter>
+<shape type="sphere"><bsdf type="diffuse"><rgb name="reflectanse" value="0.3"/><texture type="checkerboard" name="reflectance"/></bsdf></shape>
+<shape type="sphere"><point name="center" x="3" y="0" z="0"/><bsdf type="roughconductor"><float name="alpah" value="0.3"/></bsdf></shape></scene>"#;
+    let path = dir.join("scene.xml");
+    std::fs::write(&path, text).unwrap();
+    let path = path.to_str().unwrap();
+    let output = ais(&["render", path, "-D", "nosuch=3", "-o", out, "--quiet"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    for expected in [
+        r#"scene.xml:1: a second <default> of "a" is ignored"#,
+        r#"scene.xml:3: component_format "float16""#,
+        r#"scene.xml:4: property "sample_cont" of sampler"#,
+        r#"scene.xml:5: attribute "foo" of <emitter>"#,
+        r#"scene.xml:5: property "scael" of emitter"#,
+        r#"scene.xml:6: property "reflectanse" of bsdf"#,
+        "scene.xml:6: textures are not supported",
+        r#"scene.xml:7: property "alpah" of bsdf"#,
+        "-D nosuch=3 is not used",
+    ] {
+        assert!(
+            stderr.contains(expected),
+            "{expected:?} missing from {stderr}"
+        );
+    }
+    refused(
+        &["render", path, "-o", out, "--strict"],
+        "--strict makes them errors",
+    );
+    // Mitsuba's default radiance of a constant emitter is 1.
+    let bare = scene(&dir, r#"<shape type="sphere"/>"#);
+    let text = std::fs::read_to_string(&bare).unwrap();
+    std::fs::write(
+        &bare,
+        text.replace(r#"<rgb name="radiance" value="1"/>"#, ""),
+    )
+    .unwrap();
+    let output = ais(&["render", &bare, "-o", out, "--quiet", "--strict"]);
+    assert!(
+        output.status.success(),
+        "{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}

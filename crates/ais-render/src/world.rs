@@ -44,14 +44,17 @@ fn shape_material(
     description: &SceneDescription,
     shape: &scene::ShapeDescription,
     warnings: &mut Vec<String>,
-) -> Material {
-    match shape.bsdf {
-        Some(index) => {
-            Material::from_plugin(&description.bsdfs[index], &description.file, warnings)
-        }
+) -> Result<Material, InputError> {
+    Ok(match shape.bsdf {
+        Some(index) => Material::from_plugin(
+            &description.bsdfs[index],
+            &description.file,
+            &description.bsdfs,
+            warnings,
+        )?,
         None if shape.emitter.is_some() => Material::diffuse(Vec3::ZERO),
         None => Material::default(),
-    }
+    })
 }
 
 /// An analytic sphere (centre, radius) under the shape's `to_world`, with its area light.
@@ -91,7 +94,10 @@ fn build_shape(
     let radiance = shape
         .emitter
         .as_ref()
-        .map(|e| radiance_property(file, e, "radiance"))
+        .map(|e| {
+            scene::warn_unknown(file, e, &["radiance"], warnings);
+            radiance_property(file, e, "radiance")
+        })
         .transpose()?;
     let mesh = match &shape.geometry {
         scene::ShapeGeometry::Sphere { center, radius } => {
@@ -142,7 +148,7 @@ impl World {
         let mut area_lights = Vec::new();
         let mut materials = Vec::with_capacity(description.shapes.len());
         for (index, shape) in description.shapes.iter().enumerate() {
-            materials.push(shape_material(&description, shape, &mut warnings));
+            materials.push(shape_material(&description, shape, &mut warnings)?);
             let built = build_shape(&file, shape, index as u32, &mut warnings)?;
             inputs.push(built.input);
             area_lights.extend(built.light);
@@ -260,10 +266,18 @@ fn environment(
 ) -> Result<Environment, InputError> {
     let at = |(line, message): (u32, String)| InputError::at(file, line, message);
     match plugin.kind.as_str() {
-        "constant" => Ok(Environment::Constant(radiance_property(
-            file, plugin, "radiance",
-        )?)),
+        "constant" => {
+            scene::warn_unknown(file, plugin, &["radiance"], warnings);
+            // Mitsuba's default radiance is 1.
+            if !plugin.properties.contains_key("radiance") {
+                return Ok(Environment::Constant(Vec3::ONE));
+            }
+            Ok(Environment::Constant(radiance_property(
+                file, plugin, "radiance",
+            )?))
+        }
         "envmap" => {
+            scene::warn_unknown(file, plugin, &["filename", "scale", "to_world"], warnings);
             let name = plugin
                 .string("filename")
                 .map_err(at)?

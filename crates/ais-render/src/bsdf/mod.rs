@@ -114,17 +114,22 @@ impl Material {
         }
     }
 
-    /// Reads a Mitsuba `<bsdf>`. Unsupported types and properties become the closest
-    /// supported material, with a warning naming the file and line.
+    /// Reads a Mitsuba `<bsdf>` of a scene read from `file`, whose top-level BSDFs `bsdfs`
+    /// its references name. Unsupported types and properties become the closest supported
+    /// material, with a warning naming the file and line; a reference to no BSDF, or a cycle
+    /// of references, is an error.
     pub fn from_plugin(
         plugin: &Plugin,
         file: &std::path::Path,
+        bsdfs: &[Plugin],
         warnings: &mut Vec<String>,
-    ) -> Material {
+    ) -> Result<Material, crate::InputError> {
         reader::BsdfReader {
             plugin,
             file,
+            bsdfs,
             warnings,
+            depth: 0,
         }
         .material()
     }
@@ -232,7 +237,9 @@ mod tests {
         let materials = scene
             .bsdfs
             .iter()
-            .map(|b| Material::from_plugin(b, Path::new("m.xml"), &mut warnings))
+            .map(|b| {
+                Material::from_plugin(b, Path::new("m.xml"), &scene.bsdfs, &mut warnings).unwrap()
+            })
             .collect();
         (materials, warnings)
     }

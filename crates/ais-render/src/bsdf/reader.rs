@@ -3,6 +3,7 @@
 //! line.
 
 use super::{named_conductor, Material, Microfacet, MicrofacetKind, RoughPlastic, Scattering};
+use crate::error::InputError;
 use crate::scene::{Plugin, Property};
 use glam::Vec3;
 
@@ -12,8 +13,44 @@ pub(super) struct BsdfReader<'a> {
     pub plugin: &'a Plugin,
     /// The scene file, for warnings.
     pub file: &'a std::path::Path,
+    /// The scene's top-level BSDFs, which references name.
+    pub bsdfs: &'a [Plugin],
     /// Warnings so far.
     pub warnings: &'a mut Vec<String>,
+    /// How many BSDFs this one is nested in (through children or references).
+    pub depth: usize,
+}
+
+/// The deepest a BSDF may be nested in others, references included: deeper is a cycle.
+const DEEPEST_BSDF: usize = 16;
+
+/// The properties each supported BSDF reads.
+fn known_properties(kind: &str) -> &'static [&'static str] {
+    match kind {
+        "diffuse" => &["reflectance"],
+        "roughconductor" => &[
+            "distribution",
+            "alpha",
+            "alpha_u",
+            "alpha_v",
+            "material",
+            "eta",
+            "k",
+            "specular_reflectance",
+            "sample_visible",
+        ],
+        "roughplastic" => &[
+            "distribution",
+            "alpha",
+            "int_ior",
+            "ext_ior",
+            "diffuse_reflectance",
+            "specular_reflectance",
+            "nonlinear",
+            "sample_visible",
+        ],
+        _ => &[],
+    }
 }
 
 /// A colour property given as rgb or a float, or `default`.
@@ -104,31 +141,84 @@ impl BsdfReader<'_> {
     }
 
     /// The material this element describes.
-    pub fn material(&mut self) -> Material {
-        match self.plugin.kind.as_str() {
+    pub fn material(&mut self) -> Result<Material, InputError> {
+        if self.depth > DEEPEST_BSDF {
+            return Err(InputError::at(
+                self.file,
+                self.plugin.line,
+                format!("BSDFs nest more than {DEEPEST_BSDF} deep: a cycle of references?"),
+            ));
+        }
+        self.warn_ignored();
+        Ok(match self.plugin.kind.as_str() {
             "diffuse" => {
                 let reflectance = self.colour("reflectance", Vec3::splat(0.5));
                 Material::diffuse(reflectance.min(Vec3::ONE))
             }
             "roughconductor" => self.rough_conductor(),
             "roughplastic" => self.rough_plastic(),
-            "twosided" => {
-                let inner = match self.plugin.children.first() {
-                    Some(child) => Material::from_plugin(child, self.file, self.warnings),
-                    None => Material::default(),
-                };
-                Material {
-                    two_sided: true,
-                    ..inner
-                }
-            }
+            "twosided" => Material {
+                two_sided: true,
+                ..self.nested()?
+            },
             other => {
                 self.warn(format!(
                     "bsdf \"{other}\" is not implemented; rendered as diffuse 0.5"
                 ));
                 Material::default()
             }
+        })
+    }
+
+    /// Warns of the properties and nested elements this BSDF does not read.
+    fn warn_ignored(&mut self) {
+        let plugin = self.plugin;
+        if matches!(
+            plugin.kind.as_str(),
+            "diffuse" | "roughconductor" | "roughplastic"
+        ) {
+            let known = known_properties(&plugin.kind);
+            crate::scene::warn_unknown(self.file, plugin, known, self.warnings);
         }
+        for child in plugin.children.iter().filter(|c| c.tag == "texture") {
+            self.warnings.push(format!(
+                "{}:{}: textures are not supported: {} \"{}\" keeps its default",
+                self.file.display(),
+                child.line,
+                child.name.as_deref().unwrap_or("the parameter"),
+                plugin.kind
+            ));
+        }
+    }
+
+    /// The BSDF a `twosided` wraps: its nested `<bsdf>` or the one its `<ref>` names.
+    fn nested(&mut self) -> Result<Material, InputError> {
+        let plugin = self.plugin;
+        let inner = match (
+            plugin.children.iter().find(|c| c.tag == "bsdf"),
+            plugin.references.first(),
+        ) {
+            (Some(child), _) => child,
+            (None, Some((_, id, line))) => self
+                .bsdfs
+                .iter()
+                .find(|b| b.id.as_deref() == Some(id.as_str()))
+                .ok_or_else(|| {
+                    InputError::at(self.file, *line, format!("no <bsdf> with id \"{id}\""))
+                })?,
+            (None, None) => {
+                self.warn("twosided holds no BSDF; using diffuse 0.5".into());
+                return Ok(Material::default());
+            }
+        };
+        BsdfReader {
+            plugin: inner,
+            file: self.file,
+            bsdfs: self.bsdfs,
+            warnings: self.warnings,
+            depth: self.depth + 1,
+        }
+        .material()
     }
 
     /// A colour property: non-negative and finite, else `default` with a warning.

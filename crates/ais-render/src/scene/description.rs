@@ -223,6 +223,7 @@ fn read_sensor(
         match child.tag.as_str() {
             "film" => scene.resolution = read_film(path, child, &mut scene.warnings)?,
             "sampler" => {
+                warn_unknown(path, child, &["sample_count", "seed"], &mut scene.warnings);
                 let count = child.integer("sample_count", 4)?;
                 if count < 1 {
                     return Err((
@@ -324,6 +325,13 @@ fn read_film(
         "rfilter",
     ];
     warn_unknown(path, film, &KNOWN, warnings);
+    if let Some(format) = film.string("component_format")?.filter(|f| *f != "float32") {
+        warnings.push(format!(
+            "{}:{}: component_format \"{format}\" is not supported; the EXR holds float32",
+            path.display(),
+            film.line
+        ));
+    }
     for filter in &film.children {
         if filter.kind != "box" {
             warnings.push(format!(
@@ -442,7 +450,13 @@ fn attachments(shape: &Plugin, scene: &mut SceneDescription) -> Result<Attachmen
     Ok(attached)
 }
 
-fn warn_unknown(path: &Path, plugin: &Plugin, known: &[&str], warnings: &mut Vec<String>) {
+/// Warns of the properties of `plugin` that are not in `known`, naming file and line.
+pub(crate) fn warn_unknown(
+    path: &Path,
+    plugin: &Plugin,
+    known: &[&str],
+    warnings: &mut Vec<String>,
+) {
     for (name, line) in plugin.unknown_properties(known) {
         warnings.push(format!(
             "{}:{line}: property \"{name}\" of {} \"{}\" is ignored",

@@ -4,6 +4,7 @@ mod description;
 mod properties;
 mod xml;
 
+pub(crate) use description::warn_unknown;
 pub use description::{
     load_scene, parse_scene, CameraDescription, FovAxis, MeshFormat, SceneDescription,
     ShapeDescription, ShapeGeometry,

@@ -38,7 +38,21 @@ struct Reader<'a> {
     file: &'a Path,
     text: &'a str,
     parameters: HashMap<String, String>,
+    /// The parameters a `$name` has used.
+    used: std::cell::RefCell<std::collections::HashSet<String>>,
     warnings: Vec<String>,
+}
+
+/// The attributes each kind of element may carry.
+fn known_attributes(tag: &str) -> &'static [&'static str] {
+    match tag {
+        "float" | "integer" | "boolean" | "string" | "rgb" => &["name", "value"],
+        "point" | "vector" => &["name", "value", "x", "y", "z"],
+        "transform" => &["name"],
+        "ref" => &["id", "name"],
+        _ if PLUGIN_TAGS.contains(&tag) => &["type", "id", "name"],
+        _ => &[],
+    }
 }
 
 /// Parses the Mitsuba XML in `text` (read from `file`). `overrides` set `$param` values and
@@ -57,6 +71,7 @@ pub fn parse(
         file,
         text,
         parameters: overrides.iter().cloned().collect(),
+        used: Default::default(),
         warnings: Vec::new(),
     };
     if root.tag_name().name() != "scene" {
@@ -68,17 +83,7 @@ pub fn parse(
             ),
         ));
     }
-    // Defaults first, wherever they are, so that they apply to the whole file.
-    for child in root.children().filter(|n| n.is_element()) {
-        if child.tag_name().name() == "default" {
-            let name = reader.raw_attribute(child, "name")?;
-            let value = reader.raw_attribute(child, "value")?;
-            reader
-                .parameters
-                .entry(name.to_string())
-                .or_insert_with(|| value.to_string());
-        }
-    }
+    reader.read_defaults(root, overrides)?;
     let mut plugins = Vec::new();
     for child in root.children().filter(|n| n.is_element()) {
         let tag = child.tag_name().name();
@@ -93,13 +98,100 @@ pub fn parse(
             return Err(reader.unexpected(child, "<scene>"));
         }
     }
+    reader.warn_unused_overrides(overrides);
+    check_unique_ids(file, &plugins)?;
     Ok(ParsedScene {
         plugins,
         warnings: reader.warnings,
     })
 }
 
+/// Refuses two plugins with the same id: a reference to it would be ambiguous.
+fn check_unique_ids(file: &Path, plugins: &[Plugin]) -> Result<(), InputError> {
+    fn visit<'p>(
+        plugin: &'p Plugin,
+        seen: &mut HashMap<&'p str, u32>,
+        file: &Path,
+    ) -> Result<(), InputError> {
+        if let Some(id) = plugin.id.as_deref() {
+            if let Some(first) = seen.insert(id, plugin.line) {
+                return Err(InputError::at(
+                    file,
+                    plugin.line,
+                    format!("id \"{id}\" is already used on line {first}"),
+                ));
+            }
+        }
+        plugin
+            .children
+            .iter()
+            .try_for_each(|child| visit(child, seen, file))
+    }
+    let mut seen = HashMap::new();
+    plugins
+        .iter()
+        .try_for_each(|plugin| visit(plugin, &mut seen, file))
+}
+
 impl<'a> Reader<'a> {
+    /// Reads the `<default>`s, wherever they are, so that they apply to the whole file;
+    /// command-line overrides win, and a second default of one name warns.
+    fn read_defaults(
+        &mut self,
+        root: roxmltree::Node,
+        overrides: &[(String, String)],
+    ) -> Result<(), InputError> {
+        let mut defaulted = std::collections::HashSet::new();
+        for child in root.children().filter(|n| n.is_element()) {
+            if child.tag_name().name() != "default" {
+                continue;
+            }
+            let name = self.raw_attribute(child, "name")?;
+            let value = self.raw_attribute(child, "value")?;
+            if !defaulted.insert(name.to_string()) {
+                let line = self.line(child);
+                self.warnings.push(format!(
+                    "{}:{line}: a second <default> of \"{name}\" is ignored",
+                    self.file.display()
+                ));
+                continue;
+            }
+            if !overrides.iter().any(|(n, _)| n == name) {
+                self.parameters.insert(name.to_string(), value.to_string());
+            }
+        }
+        Ok(())
+    }
+
+    /// Warns of command-line overrides that no `$name` used.
+    fn warn_unused_overrides(&mut self, overrides: &[(String, String)]) {
+        let used = self.used.borrow();
+        for (name, value) in overrides {
+            if !used.contains(name) {
+                self.warnings.push(format!(
+                    "{}: -D {name}={value} is not used: the scene has no ${name}",
+                    self.file.display()
+                ));
+            }
+        }
+    }
+
+    /// Warns of attributes `node` does not read.
+    fn warn_unknown_attributes(&mut self, node: roxmltree::Node) {
+        let known = known_attributes(node.tag_name().name());
+        for attribute in node.attributes() {
+            if !known.contains(&attribute.name()) {
+                let line = self.line(node);
+                self.warnings.push(format!(
+                    "{}:{line}: attribute \"{}\" of <{}> is ignored",
+                    self.file.display(),
+                    attribute.name(),
+                    node.tag_name().name()
+                ));
+            }
+        }
+    }
+
     fn line(&self, node: roxmltree::Node) -> u32 {
         self.text[..node.range().start].matches('\n').count() as u32 + 1
     }
@@ -159,6 +251,7 @@ impl<'a> Reader<'a> {
             if name.is_empty() {
                 return Err(self.error(node, format!("a lone '$' in \"{raw}\"")));
             }
+            self.used.borrow_mut().insert(name.to_string());
             let value = self.parameters.get(name).ok_or_else(|| {
                 self.error(
                     node,
@@ -182,6 +275,7 @@ impl<'a> Reader<'a> {
                 format!("plugins are nested more than {DEEPEST_NESTING} deep"),
             ));
         }
+        self.warn_unknown_attributes(node);
         let tag = node.tag_name().name().to_string();
         let kind = self.attribute(node, "type")?;
         let mut plugin = Plugin {
@@ -205,6 +299,7 @@ impl<'a> Reader<'a> {
             } else if child_tag == "default" {
                 return Err(self.error(child, "<default> must be a direct child of <scene>"));
             } else {
+                self.warn_unknown_attributes(child);
                 let name = self.attribute(child, "name")?;
                 let value = self.property(child)?;
                 let line = self.line(child);
