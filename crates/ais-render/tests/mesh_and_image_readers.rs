@@ -1,5 +1,7 @@
 //! Mesh and image readers on files the tests generate.
 
+mod common;
+
 use ais_render::image_io::{read_image, write_exr, RgbImage};
 use ais_render::mesh::load_mesh;
 use ais_render::scene::MeshFormat;
@@ -73,14 +75,12 @@ fn degenerate_triangles_are_dropped_with_a_warning() {
     );
 }
 
-const PLY_HEADER: &str = "ply\nformat {FORMAT} 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n";
-
 #[test]
 fn ply_ascii_and_binary() {
     let ascii = scratch("quad_ascii.ply");
     std::fs::write(
         &ascii,
-        PLY_HEADER.replace("{FORMAT}", "ascii") + "0 0 0\n2 0 0\n2 2 0\n0 2 0\n4 0 1 2 3\n",
+        common::PLY_HEADER.replace("{FORMAT}", "ascii") + "0 0 0\n2 0 0\n2 2 0\n0 2 0\n4 0 1 2 3\n",
     )
     .unwrap();
     let loaded = load_mesh(&ascii, MeshFormat::Ply).unwrap();
@@ -88,7 +88,7 @@ fn ply_ascii_and_binary() {
     assert!((loaded.mesh.area() - 4.0).abs() < 1e-6);
 
     let binary = scratch("quad_binary.ply");
-    let mut bytes = PLY_HEADER
+    let mut bytes = common::PLY_HEADER
         .replace("{FORMAT}", "binary_little_endian")
         .into_bytes();
     for v in [
@@ -112,51 +112,17 @@ fn ply_ascii_and_binary() {
     let truncated = scratch("truncated.ply");
     std::fs::write(
         &truncated,
-        PLY_HEADER.replace("{FORMAT}", "ascii") + "0 0 0\n",
+        common::PLY_HEADER.replace("{FORMAT}", "ascii") + "0 0 0\n",
     )
     .unwrap();
     let e = load_mesh(&truncated, MeshFormat::Ply).unwrap_err();
     assert!(e.to_string().contains("truncated.ply"), "{e}");
 }
 
-/// A minimal GLB: one triangle, optionally declaring Draco compression.
-fn glb(draco: bool) -> Vec<u8> {
-    let mut bin = Vec::new();
-    for v in [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
-        for c in v {
-            bin.extend(c.to_le_bytes());
-        }
-    }
-    let extensions = if draco {
-        r#""extensionsUsed":["KHR_draco_mesh_compression"],"extensionsRequired":["KHR_draco_mesh_compression"],"#
-    } else {
-        ""
-    };
-    let json = format!(
-        r#"{{"asset":{{"version":"2.0"}},{extensions}"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0,"translation":[0,0,2]}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"buffers":[{{"byteLength":36}}],"bufferViews":[{{"buffer":0,"byteLength":36}}],"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}]}}"#
-    );
-    let mut json = json.into_bytes();
-    while json.len() % 4 != 0 {
-        json.push(b' ');
-    }
-    let total = 12 + 8 + json.len() + 8 + bin.len();
-    let mut out = Vec::new();
-    out.extend(b"glTF");
-    out.extend(2u32.to_le_bytes());
-    out.extend((total as u32).to_le_bytes());
-    out.extend((json.len() as u32).to_le_bytes());
-    out.extend(b"JSON");
-    out.extend(json);
-    out.extend((bin.len() as u32).to_le_bytes());
-    out.extend(b"BIN\0");
-    out.extend(bin);
-    out
-}
-
 #[test]
 fn glb_plain_and_draco() {
     let plain = scratch("triangle.glb");
-    std::fs::write(&plain, glb(false)).unwrap();
+    std::fs::write(&plain, common::glb(false)).unwrap();
     let loaded = load_mesh(&plain, MeshFormat::Glb).unwrap();
     assert_eq!(loaded.mesh.triangles.len(), 1);
     assert!(
@@ -164,7 +130,7 @@ fn glb_plain_and_draco() {
         "node transform applied"
     );
     let draco = scratch("draco.glb");
-    std::fs::write(&draco, glb(true)).unwrap();
+    std::fs::write(&draco, common::glb(true)).unwrap();
     let e = load_mesh(&draco, MeshFormat::Glb).unwrap_err().to_string();
     assert!(
         e.contains("KHR_draco_mesh_compression") && e.contains("draco.glb"),
@@ -227,4 +193,14 @@ fn radiance_hdr_is_read() {
         .unwrap_err()
         .to_string()
         .contains("unsupported image format"));
+}
+
+#[test]
+fn a_glb_that_crashed_the_gltf_reader_gives_an_error() {
+    // Found by tests/fuzz_readers.rs: a mutated GLB whose POSITION names a missing accessor
+    // made the gltf crate panic (an index out of bounds in its validation).
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/accessor-out-of-range.glb");
+    let error = load_mesh(&path, MeshFormat::Glb).unwrap_err();
+    assert!(error.to_string().contains("malformed"), "{error}");
 }

@@ -96,6 +96,17 @@ impl Assembly<'_> {
 
 /// Reads every triangle primitive of the default scene's nodes, with node transforms applied.
 pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
+    // The gltf crate panics on some malformed files (an accessor index out of range).
+    crate::error::catch_panic(|| read_unguarded(path)).unwrap_or_else(|message| {
+        Err(InputError::new(
+            path,
+            format!("the GLB is malformed (the glTF reader failed: {message})"),
+        ))
+    })
+}
+
+/// [`read`], which the gltf crate may make panic.
+fn read_unguarded(path: &Path) -> Result<TriangleMesh, InputError> {
     let bytes =
         std::fs::read(path).map_err(|e| InputError::new(path, format!("cannot read GLB: {e}")))?;
     let gltf = gltf::Gltf::from_slice(&bytes)
