@@ -35,11 +35,12 @@ impl RgbImage {
         }
     }
 
-    /// Replaces NaN, infinite and negative channels by 0; returns how many there were.
+    /// Replaces NaN, infinite, negative and absurdly large (above [`LARGEST_TEXEL`])
+    /// channels by 0; returns how many there were.
     pub fn sanitize(&mut self) -> usize {
         let mut count = 0;
         for channel in self.pixels.iter_mut().flatten() {
-            if !(channel.is_finite() && *channel >= 0.0) {
+            if !(channel.is_finite() && (0.0..=LARGEST_TEXEL).contains(channel)) {
                 *channel = 0.0;
                 count += 1;
             }
@@ -47,6 +48,10 @@ impl RgbImage {
         count
     }
 }
+
+/// The largest texel value read as is: beyond it, sums of texels (an envmap's sampling
+/// weights, a pixel's estimate) overflow f32.
+pub const LARGEST_TEXEL: f32 = 1e20;
 
 /// Reads an `.exr` or `.hdr` file into linear RGB, sanitising bad texels.
 pub fn read_image(path: &Path) -> Result<LoadedImage, InputError> {
@@ -68,7 +73,7 @@ pub fn read_image(path: &Path) -> Result<LoadedImage, InputError> {
     let bad = image.sanitize();
     let warning = (bad > 0).then(|| {
         format!(
-            "{}: {bad} texel channel(s) were NaN, infinite or negative and were clamped to 0",
+            "{}: {bad} texel channel(s) were NaN, infinite, negative or above 1e20 and were set to 0",
             path.display()
         )
     });
@@ -76,6 +81,7 @@ pub fn read_image(path: &Path) -> Result<LoadedImage, InputError> {
 }
 
 fn read_exr(path: &Path) -> Result<RgbImage, InputError> {
+    check_rgb_channels(path)?;
     let result = exr::prelude::read_first_rgba_layer_from_file(
         path,
         |resolution, _| RgbImage::new(resolution.width(), resolution.height()),
@@ -86,6 +92,37 @@ fn read_exr(path: &Path) -> Result<RgbImage, InputError> {
     )
     .map_err(|e| InputError::new(path, format!("cannot read EXR: {e}")))?;
     Ok(result.layer_data.channel_data.pixels)
+}
+
+/// Refuses an EXR whose first layer has no R, G or B channel (a luminance-only image, say),
+/// naming the channels it has.
+fn check_rgb_channels(path: &Path) -> Result<(), InputError> {
+    let meta = exr::meta::MetaData::read_from_file(path, false)
+        .map_err(|e| InputError::new(path, format!("cannot read EXR: {e}")))?;
+    let Some(header) = meta.headers.first() else {
+        return Err(InputError::new(path, "the EXR has no layer"));
+    };
+    let names: Vec<String> = header
+        .channels
+        .list
+        .iter()
+        .map(|c| c.name.to_string())
+        .collect();
+    let has = |name: &str| {
+        names
+            .iter()
+            .any(|n| n == name || n.ends_with(&format!(".{name}")))
+    };
+    if has("R") || has("G") || has("B") {
+        return Ok(());
+    }
+    Err(InputError::new(
+        path,
+        format!(
+            "the EXR has the channels {} but no R, G or B; ais reads RGB images",
+            names.join(", ")
+        ),
+    ))
 }
 
 fn read_hdr(path: &Path) -> Result<RgbImage, InputError> {

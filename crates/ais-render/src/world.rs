@@ -297,6 +297,21 @@ fn environment(
             for p in &mut image.pixels {
                 *p = p.map(|c| c * scale);
             }
+            if image
+                .pixels
+                .iter()
+                .flatten()
+                .any(|&c| c > crate::image_io::LARGEST_TEXEL)
+            {
+                return Err(InputError::at(
+                    file,
+                    plugin.line,
+                    format!(
+                        "envmap scale {scale:e} makes texels exceed {:e}",
+                        crate::image_io::LARGEST_TEXEL
+                    ),
+                ));
+            }
             let to_world = plugin.transform("to_world").map_err(at)?;
             let rotation = DMat3::from_mat4(to_world);
             Ok(Environment::Map(Box::new(EnvironmentMap::new(

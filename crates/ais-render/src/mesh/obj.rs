@@ -5,8 +5,34 @@ use crate::error::InputError;
 use glam::Vec3;
 use std::path::Path;
 
+/// Refuses faces of fewer than three vertices, naming their line (tobj would turn them into
+/// degenerate triangles, and the error would blame the geometry).
+fn check_faces(path: &Path) -> Result<(), InputError> {
+    use std::io::BufRead;
+    let file = std::fs::File::open(path)
+        .map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
+    for (number, line) in std::io::BufReader::new(file).split(b'\n').enumerate() {
+        let line = line.map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
+        let mut words = line
+            .split(|b| b.is_ascii_whitespace())
+            .filter(|w| !w.is_empty());
+        if words.next() == Some(b"f".as_slice()) {
+            let vertices = words.count();
+            if vertices < 3 {
+                return Err(InputError::at(
+                    path,
+                    number as u32 + 1,
+                    format!("a face needs at least 3 vertices, this one has {vertices}"),
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
 /// Reads every object of an OBJ file into one mesh (polygons are triangulated).
 pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
+    check_faces(path)?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,

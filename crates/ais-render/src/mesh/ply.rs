@@ -53,13 +53,18 @@ fn read_faces(
     mesh: &mut TriangleMesh,
 ) -> Result<(), InputError> {
     for (index, face) in faces.iter().enumerate() {
-        let list = face
+        let property = face
             .get("vertex_indices")
             .or_else(|| face.get("vertex_index"))
-            .and_then(Property::to_u32_list)
             .ok_or_else(|| {
                 InputError::new(path, format!("PLY face {index} has no vertex_indices list"))
             })?;
+        let list = property.to_u32_list().ok_or_else(|| {
+            InputError::new(
+                path,
+                format!("PLY face {index} has a vertex index that is negative or not an integer"),
+            )
+        })?;
         if list.len() < 3 {
             return Err(InputError::new(
                 path,

@@ -64,7 +64,13 @@ pub fn parse(
 ) -> Result<ParsedScene, InputError> {
     let document = roxmltree::Document::parse(text).map_err(|e| {
         let position = e.pos();
-        InputError::at(file, position.row, format!("malformed XML: {e}"))
+        let hint = match e {
+            roxmltree::Error::UnexpectedEndOfStream => {
+                " (the file ends before its elements are closed: is it truncated?)"
+            }
+            _ => "",
+        };
+        InputError::at(file, position.row, format!("malformed XML: {e}{hint}"))
     })?;
     let root = document.root_element();
     let mut reader = Reader {

@@ -61,8 +61,13 @@ impl LogLogPlot<'_> {
     /// The plot of `series` as SVG.
     pub fn svg(&self, series: &[Series]) -> Result<String, String> {
         let title = self.title;
-        let (x_range, y_range) =
-            log_ranges(series).ok_or_else(|| format!("{title}: nothing to plot"))?;
+        let Some((x_range, y_range)) = log_ranges(series) else {
+            // A black scene, or a perfect match: every relMSE is zero.
+            return Ok(format!(
+                r#"<svg xmlns="http://www.w3.org/2000/svg" width="{}" height="{}"><text x="12" y="24">{title}: no positive relMSE to plot (a black scene, or a perfect match)</text></svg>"#,
+                self.size.0, self.size.1
+            ));
+        };
         let mut svg = String::new();
         {
             let root = SVGBackend::with_string(&mut svg, self.size).into_drawing_area();
@@ -144,6 +149,6 @@ mod tests {
         }
         assert!(!svg.contains("#2CA02C"), "a third series appeared");
         assert!(svg.contains("aggressive") && svg.contains("seconds"));
-        assert!(plot("t").svg(&[]).is_err());
+        assert!(plot("t").svg(&[]).unwrap().contains("no positive relMSE"));
     }
 }

@@ -79,6 +79,15 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
     out
 }
 
+/// A mean with its standard error; one seed has none.
+fn with_error((mean, error): (f64, f64)) -> String {
+    if error.is_finite() {
+        format!("{mean:.3e} ± {error:.1e}")
+    } else {
+        format!("{mean:.3e} (one seed: no error bar)")
+    }
+}
+
 /// The equal-time table, with its introduction.
 fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row]) -> String {
     let pixels = (context.resolution.0 * context.resolution.1) as f64;
@@ -99,7 +108,7 @@ fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row
         let spp = average(runs, |r| r.spp as f64);
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {:.3e} ± {:.1e} | {:.2}× |",
+            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {:.2}× |",
             row.result.configuration.name,
             spp,
             1e3 * average(runs, |r| r.seconds) / spp,
@@ -107,8 +116,7 @@ fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row
             average(runs, |r| r.rays.occlusion as f64) / pixels,
             average(runs, |r| r.stats.rejected_roulette as f64) / pixels,
             average(runs, |r| r.ais_memory_per_thread as f64) / 1024.0,
-            row.time_rel_mse.0,
-            row.time_rel_mse.1,
+            with_error(row.time_rel_mse),
             base.time_rel_mse.0 / row.time_rel_mse.0
         );
     }
@@ -135,12 +143,11 @@ fn equal_rays_table(results: &StudyResults, rows: &[Row]) -> String {
         });
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.2} | {:.3e} ± {:.1e} | {:.2}× | {} |",
+            "| {} | {:.1} | {:.2} | {} | {:.2}× | {} |",
             row.result.configuration.name,
             average(&row.result.equal_rays, |r| r.spp as f64),
             average(&row.result.equal_rays, |r| r.seconds),
-            row.rays_rel_mse.0,
-            row.rays_rel_mse.1,
+            with_error(row.rays_rel_mse),
             base.rays_rel_mse.0 / row.rays_rel_mse.0,
             if share.is_finite() {
                 format!("{:.0}%", 100.0 * share)
