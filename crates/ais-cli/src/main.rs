@@ -114,6 +114,12 @@ fn load_world(request: &SceneRequest) -> Result<World, String> {
 }
 
 fn main() -> ExitCode {
+    // An interrupted render leaves no temporary file behind, and keeps the old outputs.
+    let _ = ctrlc::set_handler(|| {
+        ais_render::atomic_write::remove_temporaries();
+        eprintln!("\ninterrupted: the previous outputs are unchanged");
+        std::process::exit(130);
+    });
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Render(args) => render_command::run(*args),

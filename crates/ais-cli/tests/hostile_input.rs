@@ -270,3 +270,32 @@ fn every_unread_input_is_named_and_strict_refuses_it() {
         String::from_utf8_lossy(&output.stderr)
     );
 }
+
+#[test]
+fn concurrent_renders_to_one_output_leave_one_render_s_files() {
+    let dir = scratch("concurrent");
+    let render = |seed: &str, out: &Path| {
+        Command::new(env!("CARGO_BIN_EXE_ais"))
+            .args(["render", "--resolution", "24x14", "--spp", "1", "--quiet"])
+            .args(["--seed", seed, "-o"])
+            .arg(out)
+            .spawn()
+            .expect("ais runs")
+    };
+    for (seed, name) in [("1", "one.exr"), ("2", "two.exr")] {
+        assert!(render(seed, &dir.join(name)).wait().unwrap().success());
+    }
+    let shared = dir.join("shared.exr");
+    for _ in 0..6 {
+        let (mut a, mut b) = (render("1", &shared), render("2", &shared));
+        assert!(a.wait().unwrap().success() && b.wait().unwrap().success());
+        let same = |x: &str, y: &str| {
+            std::fs::read(dir.join(x)).unwrap() == std::fs::read(dir.join(y)).unwrap()
+        };
+        assert_eq!(
+            same("shared.exr", "one.exr"),
+            same("shared.png", "one.png"),
+            "the EXR and the PNG come from different renders"
+        );
+    }
+}

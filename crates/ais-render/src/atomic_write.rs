@@ -33,6 +33,24 @@ pub fn write_atomically<E: From<io::Error>>(
     }
 }
 
+/// Temporary files being written now, so that an interrupt can remove them
+/// ([`remove_temporaries`]).
+static PENDING: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn pending() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    PENDING
+        .lock()
+        .unwrap_or_else(|poisoned| poisoned.into_inner())
+}
+
+/// Removes every temporary output file being written: for a SIGINT or SIGTERM handler, so
+/// that an interrupted write leaves nothing behind.
+pub fn remove_temporaries() {
+    for path in pending().drain(..) {
+        let _ = std::fs::remove_file(path);
+    }
+}
+
 /// Outputs written as a unit: each is written to a temporary file beside its target, and
 /// only when every one has been written are they all renamed over their targets. Dropped
 /// without [`OutputSet::commit`], it removes its temporary files and leaves the targets as
@@ -51,14 +69,26 @@ impl OutputSet {
         write: impl FnOnce(&Path) -> Result<(), E>,
     ) -> Result<(), E> {
         let temporary = temporary_path(target);
+        pending().push(temporary.clone());
         self.staged.push((temporary.clone(), target.to_path_buf()));
         write(&temporary)
     }
 
-    /// Renames every staged output over its target.
+    /// Renames every staged output over its target. The targets' folder is locked while
+    /// they are renamed, so that two renders to the same outputs leave one render's set,
+    /// not a mix.
     pub fn commit(mut self) -> io::Result<()> {
+        let folder = self.staged.first().and_then(|(_, target)| target.parent());
+        let folder = match folder {
+            Some(f) if !f.as_os_str().is_empty() => f.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let lock = std::fs::File::open(&folder)?;
+        lock.lock()?;
         for (temporary, target) in std::mem::take(&mut self.staged) {
+            pending().retain(|p| p != &temporary);
             std::fs::rename(&temporary, &target).map_err(|e| {
+                let _ = std::fs::remove_file(&temporary);
                 io::Error::new(e.kind(), format!("{}: cannot write: {e}", target.display()))
             })?;
         }
@@ -68,7 +98,9 @@ impl OutputSet {
 
 impl Drop for OutputSet {
     fn drop(&mut self) {
+        let mut pending = pending();
         for (temporary, _) in &self.staged {
+            pending.retain(|p| p != temporary);
             let _ = std::fs::remove_file(temporary);
         }
     }
