@@ -49,6 +49,9 @@ impl RgbImage {
     }
 }
 
+/// The most texels an image may have (16384 × 16384).
+pub const LARGEST_IMAGE_TEXELS: usize = 1 << 28;
+
 /// The largest texel value read as is: beyond it, sums of texels (an envmap's sampling
 /// weights, a pixel's estimate) overflow f32.
 pub const LARGEST_TEXEL: f32 = 1e20;
@@ -81,7 +84,7 @@ pub fn read_image(path: &Path) -> Result<LoadedImage, InputError> {
 }
 
 fn read_exr(path: &Path) -> Result<RgbImage, InputError> {
-    check_rgb_channels(path)?;
+    check_exr_header(path)?;
     let result = exr::prelude::read_first_rgba_layer_from_file(
         path,
         |resolution, _| RgbImage::new(resolution.width(), resolution.height()),
@@ -94,14 +97,25 @@ fn read_exr(path: &Path) -> Result<RgbImage, InputError> {
     Ok(result.layer_data.channel_data.pixels)
 }
 
-/// Refuses an EXR whose first layer has no R, G or B channel (a luminance-only image, say),
-/// naming the channels it has.
-fn check_rgb_channels(path: &Path) -> Result<(), InputError> {
+/// Refuses an EXR whose first layer is larger than [`LARGEST_IMAGE_TEXELS`] or has no R, G
+/// or B channel (a luminance-only image, say), naming the channels it has.
+fn check_exr_header(path: &Path) -> Result<(), InputError> {
     let meta = exr::meta::MetaData::read_from_file(path, false)
         .map_err(|e| InputError::new(path, format!("cannot read EXR: {e}")))?;
     let Some(header) = meta.headers.first() else {
         return Err(InputError::new(path, "the EXR has no layer"));
     };
+    let size = header.layer_size;
+    if size.area() > LARGEST_IMAGE_TEXELS {
+        return Err(InputError::new(
+            path,
+            format!(
+                "the EXR is {}×{} texels, more than the {LARGEST_IMAGE_TEXELS} ais reads",
+                size.width(),
+                size.height()
+            ),
+        ));
+    }
     let names: Vec<String> = header
         .channels
         .list
