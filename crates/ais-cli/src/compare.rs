@@ -1,7 +1,7 @@
 //! `ais compare`: a study of gather configurations on one scene, with an HTML report.
 
 use crate::gather_flags::{configuration, GatherFlags};
-use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest};
+use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest, ThreadFlags};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Strategy};
 use ais_study::compare::report::{self, ReportContext};
 use ais_study::compare::{reference, talk_configurations, Configuration, StudySettings};
@@ -51,9 +51,8 @@ pub struct CompareArgs {
     /// The pixel of the affinity-map figure, x,y (default: the image centre).
     #[arg(long, value_parser = parse_pixel)]
     pixel: Option<(u32, u32)>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: ThreadFlags,
     /// No progress bars.
     #[arg(short, long)]
     quiet: bool,

@@ -9,7 +9,6 @@ use std::process::ExitCode;
 mod bench_command;
 mod compare;
 mod gather_flags;
-mod limits;
 mod render_command;
 
 /// Adaptive importance sampling for multi-ray gathering: a renderer for studying it.
@@ -51,10 +50,21 @@ fn parse_define(text: &str) -> Result<(String, String), String> {
     Ok((name.to_string(), value.to_string()))
 }
 
-/// Starts `threads` rayon workers (None: one per core).
-fn start_threads(threads: Option<usize>) -> Result<(), String> {
-    if let Some(threads) = threads {
-        limits::check_threads(threads)?;
+/// How many worker threads to start.
+#[derive(clap::Args, Clone, Copy)]
+struct ThreadFlags {
+    /// Worker threads (default: all cores; at most 4 per core unless --force-threads).
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Allow more than 4 threads per core.
+    #[arg(long)]
+    force_threads: bool,
+}
+
+/// Starts the worker threads the flags ask for (default: one per core).
+fn start_threads(flags: ThreadFlags) -> Result<(), String> {
+    if let Some(threads) = flags.threads {
+        ais_render::limits::check_threads(threads, flags.force_threads)?;
         rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
             .build_global()
@@ -86,12 +96,12 @@ fn load_world(request: &SceneRequest) -> Result<World, String> {
             if let Some(resolution) = request.resolution {
                 description.resolution = resolution;
             }
-            limits::check_image_memory(description.resolution)?;
+            ais_render::limits::check_image_memory(description.resolution)?;
             World::from_description(description).map_err(|e| e.to_string())?
         }
         None => {
             let (width, height) = request.resolution.unwrap_or(request.default_resolution);
-            limits::check_image_memory((width, height))?;
+            ais_render::limits::check_image_memory((width, height))?;
             let mut world = default_world(width, height);
             world
                 .warnings

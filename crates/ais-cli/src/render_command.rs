@@ -1,7 +1,7 @@
 //! `ais render`: render a scene (or the built-in default scene) to EXR and a PNG preview.
 
 use crate::gather_flags::GatherFlags;
-use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest};
+use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest, ThreadFlags};
 use ais_render::atomic_write::OutputSet;
 use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
 use ais_render::integrators::gather::GatherStats;
@@ -35,9 +35,8 @@ pub struct RenderArgs {
     /// Samples per pixel (default: the scene's sample_count; 4 for the default scene).
     #[arg(long)]
     spp: Option<u32>,
-    /// Worker threads (default: all cores).
-    #[arg(long)]
-    threads: Option<usize>,
+    #[command(flatten)]
+    threads: ThreadFlags,
     /// Override the film size, e.g. 640x360.
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,

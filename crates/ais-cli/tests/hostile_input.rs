@@ -299,3 +299,52 @@ fn concurrent_renders_to_one_output_leave_one_render_s_files() {
         );
     }
 }
+
+#[test]
+fn compare_with_one_seed_or_a_black_scene_still_reports() {
+    let dir = scratch("compare");
+    let black = scene(&dir, r#"<shape type="sphere"/>"#);
+    let text = std::fs::read_to_string(&black).unwrap();
+    let without_light = text.replace(
+        r#"<emitter type="constant"><rgb name="radiance" value="1"/></emitter>"#,
+        "",
+    );
+    std::fs::write(&black, without_light).unwrap();
+    let report = dir.join("report");
+    let report = report.to_str().unwrap();
+    let tiny = [
+        "--time-budget",
+        "0.05",
+        "--reference-spp",
+        "4",
+        "--quiet",
+        "-o",
+        report,
+    ];
+    for (scene, seeds) in [(black.as_str(), "2"), (black.as_str(), "1")] {
+        let output = ais(&[&["compare", scene, "--seeds", seeds][..], &tiny[..]].concat());
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        assert!(
+            output.status.success(),
+            "{}",
+            String::from_utf8_lossy(&output.stderr)
+        );
+        assert!(!stdout.contains("NaN"), "{stdout}");
+    }
+    let sky = dir.join("sky.hdr");
+    let hdr = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/assets/sky.hdr");
+    if hdr.exists() {
+        std::fs::copy(&hdr, &sky).unwrap();
+        let scaled = scene(&dir, r#"<shape type="sphere"/>"#);
+        let text = std::fs::read_to_string(&scaled).unwrap().replace(
+            r#"<emitter type="constant"><rgb name="radiance" value="1"/></emitter>"#,
+            r#"<emitter type="envmap"><string name="filename" value="sky.hdr"/><float name="scale" value="1e37"/></emitter>"#,
+        );
+        std::fs::write(&scaled, text).unwrap();
+        let out = dir.join("out.exr");
+        refused(
+            &["render", &scaled, "-o", out.to_str().unwrap()],
+            "makes texels exceed",
+        );
+    }
+}

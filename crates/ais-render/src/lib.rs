@@ -17,6 +17,7 @@ pub mod geometry;
 pub mod image_io;
 pub mod integrators;
 pub mod lights;
+pub mod limits;
 pub mod mesh;
 pub mod render;
 pub mod scene;

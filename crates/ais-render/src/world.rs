@@ -153,6 +153,15 @@ impl World {
             inputs.push(built.input);
             area_lights.extend(built.light);
         }
+        let triangles = inputs
+            .iter()
+            .map(|input| match &input.geometry {
+                ShapeGeometry::Mesh(mesh) => mesh.triangles.len(),
+                ShapeGeometry::Sphere(_) => 1,
+            })
+            .sum();
+        crate::limits::check_geometry_memory(triangles)
+            .map_err(|message| InputError::new(&file, message))?;
         let geometry = Geometry::build(inputs);
         let environment = match description.emitters.as_slice() {
             [] => None,

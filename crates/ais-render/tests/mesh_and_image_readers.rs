@@ -204,3 +204,50 @@ fn a_glb_that_crashed_the_gltf_reader_gives_an_error() {
     let error = load_mesh(&path, MeshFormat::Glb).unwrap_err();
     assert!(error.to_string().contains("malformed"), "{error}");
 }
+
+#[test]
+fn malformed_files_are_named_for_what_is_wrong() {
+    let obj = scratch("two.obj");
+    std::fs::write(&obj, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n").unwrap();
+    let e = load_mesh(&obj, MeshFormat::Obj).unwrap_err().to_string();
+    assert!(
+        e.contains("two.obj:4: a face needs at least 3 vertices"),
+        "{e}"
+    );
+
+    let ply = scratch("negative.ply");
+    let mut bytes = "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n".as_bytes().to_vec();
+    for c in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bytes.extend(c.to_le_bytes());
+    }
+    bytes.push(3);
+    for i in [0i32, -1, 2] {
+        bytes.extend(i.to_le_bytes());
+    }
+    std::fs::write(&ply, bytes).unwrap();
+    let e = load_mesh(&ply, MeshFormat::Ply).unwrap_err().to_string();
+    assert!(e.contains("negative or not an integer"), "{e}");
+
+    let luminance = scratch("luminance.exr");
+    use exr::prelude::*;
+    let channel = AnyChannel::new("Y", FlatSamples::F32(vec![1.0; 8]));
+    let mut channels = SmallVec::new();
+    channels.push(channel);
+    Image::from_channels((4, 2), AnyChannels::sort(channels))
+        .write()
+        .to_file(&luminance)
+        .unwrap();
+    let e = read_image(&luminance).unwrap_err().to_string();
+    assert!(e.contains("channels Y but no R, G or B"), "{e}");
+
+    let huge = scratch("huge.exr");
+    let image = RgbImage {
+        width: 2,
+        height: 1,
+        pixels: vec![[3e38, 1.0, 1.0], [1.0, 1.0, 1.0]],
+    };
+    write_exr(&huge, &image).unwrap();
+    let loaded = read_image(&huge).unwrap();
+    assert_eq!(loaded.image.pixels[0], [0.0, 1.0, 1.0]);
+    assert!(loaded.warning.unwrap().contains("above 1e20"));
+}

@@ -198,3 +198,11 @@ fn every_error_names_file_line_and_problem() {
         );
     }
 }
+
+#[test]
+fn a_truncated_file_says_so() {
+    let e = parse(r#"<scene version="3.0.0"><shape type="sphere"><bsdf type="diff"#)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("is it truncated?"), "{e}");
+}

@@ -79,6 +79,17 @@ pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> Strin
     out
 }
 
+/// The baseline's relMSE over a configuration's, or a dash where it means nothing (a black
+/// scene, where both are 0).
+fn ratio(baseline: f64, value: f64) -> String {
+    let ratio = baseline / value;
+    if ratio.is_finite() {
+        format!("{ratio:.2}×")
+    } else {
+        "–".into()
+    }
+}
+
 /// A mean with its standard error; one seed has none.
 fn with_error((mean, error): (f64, f64)) -> String {
     if error.is_finite() {
@@ -108,7 +119,7 @@ fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row
         let spp = average(runs, |r| r.spp as f64);
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {:.2}× |",
+            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {} |",
             row.result.configuration.name,
             spp,
             1e3 * average(runs, |r| r.seconds) / spp,
@@ -117,7 +128,7 @@ fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row
             average(runs, |r| r.stats.rejected_roulette as f64) / pixels,
             average(runs, |r| r.ais_memory_per_thread as f64) / 1024.0,
             with_error(row.time_rel_mse),
-            base.time_rel_mse.0 / row.time_rel_mse.0
+            ratio(base.time_rel_mse.0, row.time_rel_mse.0)
         );
     }
     out
@@ -143,12 +154,12 @@ fn equal_rays_table(results: &StudyResults, rows: &[Row]) -> String {
         });
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.2} | {} | {:.2}× | {} |",
+            "| {} | {:.1} | {:.2} | {} | {} | {} |",
             row.result.configuration.name,
             average(&row.result.equal_rays, |r| r.spp as f64),
             average(&row.result.equal_rays, |r| r.seconds),
             with_error(row.rays_rel_mse),
-            base.rays_rel_mse.0 / row.rays_rel_mse.0,
+            ratio(base.rays_rel_mse.0, row.rays_rel_mse.0),
             if share.is_finite() {
                 format!("{:.0}%", 100.0 * share)
             } else {
