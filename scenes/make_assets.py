@@ -5,7 +5,8 @@
 
 writes scenes/assets/sky.hdr: a 256x128 lat-long sky in Mitsuba's orientation (+y up, u = 0
 toward -z), a horizon-bright blue gradient, a dim ground, and a small bright sun. The file is
-a flat (uncompressed) Radiance RGBE image.
+a flat (uncompressed) Radiance RGBE image. It also writes scenes/assets/blob.obj: a bumpy
+sphere of radius about 1 with 14,800 triangles, the sunlit room's mesh.
 """
 import math
 import os
@@ -37,9 +38,42 @@ def radiance(x, y, z):
     return (0.18, 0.16, 0.14)
 
 
+BLOB_COLUMNS, BLOB_ROWS = 100, 75
+
+
+def write_blob(path):
+    """A UV sphere whose radius is modulated by bumps: 2 x 100 x 74 triangles."""
+    lines = []
+    for row in range(BLOB_ROWS + 1):
+        theta = math.pi * row / BLOB_ROWS
+        for column in range(BLOB_COLUMNS):
+            phi = 2.0 * math.pi * column / BLOB_COLUMNS
+            r = 1.0 + 0.08 * math.sin(7.0 * theta) * math.sin(9.0 * phi)
+            x = r * math.sin(theta) * math.cos(phi)
+            y = r * math.cos(theta)
+            z = r * math.sin(theta) * math.sin(phi)
+            lines.append(f"v {x:.6f} {y:.6f} {z:.6f}")
+    def index(row, column):
+        return row * BLOB_COLUMNS + column % BLOB_COLUMNS + 1
+    for row in range(BLOB_ROWS):
+        for column in range(BLOB_COLUMNS):
+            a, b = index(row, column), index(row, column + 1)
+            c, d = index(row + 1, column + 1), index(row + 1, column)
+            if row > 0:
+                lines.append(f"f {a} {b} {c}")
+            if row < BLOB_ROWS - 1:
+                lines.append(f"f {a} {c} {d}")
+    temporary = path + ".tmp"
+    with open(temporary, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    os.replace(temporary, path)
+    print(f"wrote {path}")
+
+
 def main():
     folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "assets")
     os.makedirs(folder, exist_ok=True)
+    write_blob(os.path.join(folder, "blob.obj"))
     path = os.path.join(folder, "sky.hdr")
     rows = []
     for row in range(HEIGHT):

@@ -236,7 +236,8 @@ def suite_scenes():
 
 
 def ensure_assets():
-    if not os.path.exists(os.path.join(ROOT, "scenes", "assets", "sky.hdr")):
+    assets = os.path.join(ROOT, "scenes", "assets")
+    if not all(os.path.exists(os.path.join(assets, name)) for name in ("sky.hdr", "blob.obj")):
         subprocess.run([sys.executable, os.path.join(ROOT, "scenes", "make_assets.py")], check=True)
 
 

@@ -122,7 +122,6 @@ fn configurations(args: &CompareArgs, base: GatherSettings) -> Result<Vec<Config
         &format!("{}-oracle", strategies[0]),
         "oracle: the first strategy restricted to directions that bring light",
         GatherSettings {
-            placement: ais::Placement::Random,
             acceptance: Acceptance::Affinity,
             ..first.with_preset(Preset::Off)
         },

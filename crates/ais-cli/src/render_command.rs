@@ -61,8 +61,8 @@ pub struct RenderArgs {
     /// Ambient-occlusion distance in world units.
     #[arg(long, default_value_t = 1.0)]
     ao_distance: f32,
-    /// Exposure of the PNG preview, in stops.
-    #[arg(long, default_value_t = 0.0)]
+    /// Exposure of the PNG preview, in stops (negative darkens).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     exposure: f32,
     /// Base random seed.
     #[arg(long, default_value_t = 0)]

@@ -14,7 +14,7 @@ fn shipped_scenes_load_and_render() {
         Ok(folder) => folder,
         Err(why) => return common::skip("the shipped-scenes test", &why),
     };
-    for name in ["open", "occluded", "interior"] {
+    for name in ["open", "occluded", "interior", "sunlit_room"] {
         let path = folder.join(format!("{name}.xml"));
         let overrides = [
             ("res_x".to_string(), "32".to_string()),

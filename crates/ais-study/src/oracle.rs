@@ -1,13 +1,16 @@
 //! The oracle gather: a bound on what any affinity map could achieve, for studies.
 //!
-//! It draws candidates from the same proposal, but knows which of them bring light: it
-//! tests every candidate against the scene for free (counted in [`OracleStats::free_tests`],
-//! not as traced rays) and pays a traced ray only for those that bring light. Its
-//! candidate count is chosen from an independent pilot so that about `n` candidates bring
-//! light; the estimate is plain Monte Carlo over all candidates, hence exactly unbiased, at
-//! the cost of `n` traced rays: the best an ideal map could do.
+//! It draws candidates from the same proposal with the same placement as the gather it
+//! bounds (the scrambled Halton sequence, by default), through the same batch driver, but
+//! knows which of them bring light: it tests every candidate against the scene for free
+//! (counted in [`OracleStats::free_tests`], not as traced rays) and traces only those that
+//! bring light; the others are known zeros, like candidates outside the BSDF's support. Its
+//! candidate count is fixed from an independent pilot so that about `n` candidates bring
+//! light; with a fixed count the estimate is exactly unbiased, at the cost of about `n`
+//! traced rays: the best an ideal map could do with this proposal and this placement.
 
 use ais::rng::Pcg32;
+use ais::{Batch, BatchConfig, Decision, Learning, MapStart, Stopping};
 use ais_render::geometry::Ray;
 use ais_render::integrators::gather::{arriving_light, gather_point, GatherPoint, GatherSettings};
 use ais_render::render::{RayCounts, SampleIntegrator, Tile, TileState, TileStats};
@@ -19,7 +22,8 @@ const PILOT_PER_RAY: u32 = 4;
 /// Most candidates per gather ray (where almost nothing brings light).
 const MOST_PER_RAY: u32 = 64;
 
-/// The oracle gather with a gather's strategy and `rays` (the other settings are unused).
+/// The oracle gather with a gather's strategy, `rays` and placement (the other settings are
+/// unused).
 #[derive(Clone, Copy, Debug)]
 pub struct Oracle(pub GatherSettings);
 
@@ -36,19 +40,26 @@ impl TileStats for OracleStats {
     }
 }
 
-impl TileState for OracleStats {
+/// A tile's oracle state: its batch driver and its counts.
+#[derive(Default)]
+pub struct OracleTile {
+    batch: Option<Batch<[f32; 3]>>,
+    stats: OracleStats,
+}
+
+impl TileState for OracleTile {
     type Stats = OracleStats;
 
     fn finish(self) -> OracleStats {
-        self
+        self.stats
     }
 }
 
 impl SampleIntegrator for Oracle {
-    type Tile = OracleStats;
+    type Tile = OracleTile;
 
-    fn begin_tile(&self, _: &World, _: &Tile, _: &mut RayCounts) -> OracleStats {
-        OracleStats::default()
+    fn begin_tile(&self, _: &World, _: &Tile, _: &mut RayCounts) -> OracleTile {
+        OracleTile::default()
     }
 
     fn radiance(
@@ -56,7 +67,7 @@ impl SampleIntegrator for Oracle {
         world: &World,
         ray: &Ray,
         rng: &mut Pcg32,
-        stats: &mut OracleStats,
+        tile: &mut OracleTile,
         counts: &mut RayCounts,
     ) -> [f32; 3] {
         counts.closest_hit += 1;
@@ -70,13 +81,24 @@ impl SampleIntegrator for Oracle {
             return emitted.to_array();
         }
         let at = gather_point(world, &hit, -ray.direction);
+        let settings = &self.0;
+        let batch = tile.batch.get_or_insert_with(|| {
+            Batch::new(BatchConfig {
+                affinity: None,
+                learning: Learning::Off,
+                placement: settings.placement,
+                stopping: Stopping::FixedCandidates,
+                ..BatchConfig::default()
+            })
+            .expect("a valid oracle configuration")
+        });
         let mut draw = Draw {
             world,
-            settings: &self.0,
+            settings,
             at: &at,
-            stats,
+            stats: &mut tile.stats,
         };
-        (emitted + draw.gather(rng, counts)).to_array()
+        (emitted + draw.gather(batch, rng, counts)).to_array()
     }
 }
 
@@ -89,10 +111,10 @@ struct Draw<'a> {
 }
 
 impl Draw<'_> {
-    /// What a fresh candidate brings, weighed f / p (None: nothing, or outside support).
-    fn candidate(&mut self, rng: &mut Pcg32) -> Option<Vec3> {
+    /// What the candidate from `u` brings, weighed f / p (None: nothing, or outside the
+    /// support), found by a free visibility test.
+    fn candidate(&mut self, u: [f32; 2]) -> Option<Vec3> {
         let at = self.at;
-        let u = [rng.next_f32(), rng.next_f32()];
         let (direction, pdf) = self.settings.strategy.sample(at, u).filter(|s| s.1 > 0.0)?;
         if !at.material.in_support(&at.frame, at.wo, direction) {
             return None;
@@ -104,24 +126,42 @@ impl Draw<'_> {
             .then(|| at.material.eval(&at.frame, at.wo, direction) * actual / pdf as f32)
     }
 
-    /// Direct light with `rays` traced rays on average.
-    fn gather(&mut self, rng: &mut Pcg32, counts: &mut RayCounts) -> Vec3 {
+    /// The candidate count for about `rays` candidates that bring light, from a pilot of
+    /// independent candidates (so that the count does not depend on the batch's own).
+    fn candidate_count(&mut self, rng: &mut Pcg32) -> u32 {
         let n = self.settings.rays.max(1);
         let pilot = PILOT_PER_RAY * n;
-        let bringing = (0..pilot).filter(|_| self.candidate(rng).is_some()).count() as u64;
-        let candidates = if bringing == 0 {
+        let bringing = (0..pilot)
+            .filter(|_| self.candidate([rng.next_f32(), rng.next_f32()]).is_some())
+            .count() as u64;
+        let count = if bringing == 0 {
             n as u64
         } else {
             (n as u64 * pilot as u64).div_ceil(bringing)
-        }
-        .clamp(n as u64, (MOST_PER_RAY * n) as u64);
-        let mut sum = Vec3::ZERO;
-        for _ in 0..candidates {
-            if let Some(value) = self.candidate(rng) {
+        };
+        count.clamp(n as u64, (MOST_PER_RAY * n) as u64) as u32
+    }
+
+    /// Direct light with about `rays` traced rays: a fixed count of candidates through
+    /// `batch`, those that bring no light rejected as known zeros.
+    fn gather(
+        &mut self,
+        batch: &mut Batch<[f32; 3]>,
+        rng: &mut Pcg32,
+        counts: &mut RayCounts,
+    ) -> Vec3 {
+        let count = self.candidate_count(rng);
+        let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+        batch.begin(count, seed, MapStart::Empty);
+        while let Some(candidate) = batch.next_candidate() {
+            let brings = self.candidate(candidate.u);
+            let direction = self.at.frame.normal;
+            if let Decision::Trace { .. } = batch.decide(direction, brings.is_some()) {
                 counts.occlusion += 1;
-                sum += value;
+                let value = brings.expect("only candidates that bring light are traced");
+                batch.record(value.to_array(), 1.0);
             }
         }
-        sum / candidates as f32
+        Vec3::from(batch.finish().value)
     }
 }

@@ -56,7 +56,7 @@ fn the_oracle_agrees_with_the_reference_in_an_occluded_scene() {
     };
     let reference = pixel_statistics(&world, &Integrator::Gather(reference_settings), 64, 8);
     for strategy in STRATEGIES {
-        let statistics = pixel_statistics(&world, &oracle(strategy), 8, 12);
+        let statistics = pixel_statistics(&world, &oracle(strategy), 8, 48);
         if let Err(message) = agreement(&statistics, &reference) {
             panic!("{strategy:?}: {message}");
         }

@@ -164,7 +164,7 @@ pub fn talk_configurations(base: GatherSettings) -> Vec<Configuration> {
         Configuration::oracle(
             "mis-oracle",
             "PHIS restricted to visible directions (oracle)",
-            with(Strategy::Mis, Preset::Off, Random),
+            with(Strategy::Mis, Preset::Off, Halton),
         ),
     ]
 }
