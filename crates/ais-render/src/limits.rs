@@ -10,14 +10,14 @@ const BYTES_PER_TRIANGLE: u64 = 160;
 const BYTES_PER_PIXEL: u64 = 3 * 8 + 4 + 3 * 4 + 4 + 3 * 4 + 4;
 
 /// The most threads per core: beyond it the threads mostly wait for each other.
-const THREADS_PER_CORE: usize = 4;
+pub const THREADS_PER_CORE: usize = 4;
 
 /// The machine's cores.
 fn cores() -> usize {
     std::thread::available_parallelism().map_or(1, |n| n.get())
 }
 
-/// Checks a requested thread count; `forced` allows more than [`THREADS_PER_CORE`] per core.
+/// Checks a requested thread count; `forced` allows more than 4 per core.
 pub fn check_threads(threads: usize, forced: bool) -> Result<(), String> {
     let most = THREADS_PER_CORE * cores();
     if threads == 0 {
