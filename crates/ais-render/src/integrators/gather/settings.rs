@@ -7,7 +7,7 @@
 //! | `rays` | integer | 16 | candidates per gather, n (1 to 1,048,576) |
 //! | `budget` | string | `candidates` | what `rays` counts: `candidates` (AIS traces only the accepted ones) or `traced` (AIS draws extra candidates to trace about n) |
 //! | `placement` | string | `halton` | candidate placement: `halton` (scrambled per batch) or `random` |
-//! | `ais` | string | `off` | a preset of the four map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided` |
+//! | `ais` | string | `off` | a preset of the three map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided` |
 //! | `map` | string | `none` | where a batch's affinity map starts: `none` (AIS off), `batch` (empty, learned from the batch's own rays: the talk's), `neighbours` (blended from neighbouring gathers, see `sharing`) |
 //! | `update` | string | `off` | how the batch learns from its own rays, in frozen-map epochs: `off`, `aggressive`, `conservative` (the talk's shadow-edge resets) |
 //! | `map_use` | string | `roulette` | how the map is used: `roulette` (skip probably blocked candidates, weight 1/a) or `proposal` (fold the map into the proposal, reject nothing) |
@@ -114,10 +114,7 @@ impl Preset {
 
     /// Its name.
     pub fn name(self) -> &'static str {
-        Self::WORDS
-            .iter()
-            .find(|(_, p)| *p == self)
-            .map_or("", |(name, _)| name)
+        self.word()
     }
 
     /// The preset of this name.
@@ -248,6 +245,14 @@ trait Choice: Copy + PartialEq + 'static {
     const WHAT: &'static str;
     /// Its words and values.
     const WORDS: &'static [(&'static str, Self)];
+
+    /// The word for this value.
+    fn word(self) -> &'static str {
+        Self::WORDS
+            .iter()
+            .find(|(_, v)| *v == self)
+            .map_or("", |(name, _)| name)
+    }
 
     /// The value of `word`, or an error listing the words.
     fn parse_word(word: &str) -> Result<Self, String> {
@@ -487,8 +492,10 @@ impl GatherSettings {
         let axes = self.matching_preset().map_or_else(
             || {
                 format!(
-                    "map {:?}, update {:?}, use {:?}",
-                    self.map, self.update, self.map_use
+                    "map {}, update {}, map_use {}",
+                    self.map.word(),
+                    self.update.word(),
+                    self.map_use.word()
                 )
             },
             |p| p.name().to_string(),
