@@ -1,7 +1,7 @@
 //! `ais compare`: a study of gather configurations on one scene, with an HTML report.
 
 use crate::gather_flags::{configuration, GatherFlags};
-use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest, ThreadFlags};
+use crate::{load_world, parse_resolution, start_threads, SceneFlags, SceneRequest, ThreadFlags};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Strategy};
 use ais_study::compare::report::{self, ReportContext};
 use ais_study::compare::{reference, talk_configurations, Configuration, StudySettings};
@@ -56,12 +56,8 @@ pub struct CompareArgs {
     /// No progress bars.
     #[arg(short, long)]
     quiet: bool,
-    /// Set a scene $parameter: -D name=value (repeatable).
-    #[arg(short = 'D', value_parser = parse_define)]
-    define: Vec<(String, String)>,
-    /// Treat every warning about the scene as an error.
-    #[arg(long)]
-    strict: bool,
+    #[command(flatten)]
+    scene_flags: SceneFlags,
 }
 
 fn parse_pixel(text: &str) -> Result<(u32, u32), String> {
@@ -146,7 +142,7 @@ fn reference_key(
     };
     Ok(format!(
         "{scene_identity}|{:?}|{width}x{height}|{}|{}|{}|{}",
-        args.define,
+        args.scene_flags.define,
         args.reference_spp,
         rays,
         env!("CARGO_PKG_VERSION"),
@@ -183,10 +179,10 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
     check_arguments(&args)?;
     let world = load_world(&SceneRequest {
         scene: args.scene.as_deref(),
-        defines: &args.define,
+        defines: &args.scene_flags.define,
         resolution: args.resolution,
         default_resolution: (320, 180),
-        strict: args.strict,
+        strict: args.scene_flags.strict,
     })?;
     let base = args.gather.settings(
         &world.description.file,

@@ -73,6 +73,17 @@ fn start_threads(flags: ThreadFlags) -> Result<(), String> {
     Ok(())
 }
 
+/// The flags of `render` and `compare` about reading the scene.
+#[derive(clap::Args, Clone)]
+struct SceneFlags {
+    /// Set a scene $parameter: -D name=value (repeatable).
+    #[arg(short = 'D', value_parser = parse_define)]
+    define: Vec<(String, String)>,
+    /// Treat every warning about the scene as an error.
+    #[arg(long)]
+    strict: bool,
+}
+
 /// What `render` and `compare` ask to load.
 struct SceneRequest<'a> {
     /// The scene file, or None for the built-in default scene.

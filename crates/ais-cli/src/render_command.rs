@@ -1,7 +1,7 @@
 //! `ais render`: render a scene (or the built-in default scene) to EXR and a PNG preview.
 
 use crate::gather_flags::GatherFlags;
-use crate::{load_world, parse_define, parse_resolution, start_threads, SceneRequest, ThreadFlags};
+use crate::{load_world, parse_resolution, start_threads, SceneFlags, SceneRequest, ThreadFlags};
 use ais_render::atomic_write::OutputSet;
 use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
 use ais_render::integrators::gather::GatherStats;
@@ -73,12 +73,8 @@ pub struct RenderArgs {
     /// No progress bar.
     #[arg(short, long)]
     quiet: bool,
-    /// Set a scene $parameter: -D name=value (repeatable).
-    #[arg(short = 'D', value_parser = parse_define)]
-    define: Vec<(String, String)>,
-    /// Treat every warning about the scene as an error.
-    #[arg(long)]
-    strict: bool,
+    #[command(flatten)]
+    scene_flags: SceneFlags,
 }
 
 /// What a render produced, whatever integrator made it.
@@ -270,10 +266,10 @@ pub fn run(args: RenderArgs) -> Result<(), String> {
     check_outputs(&args)?;
     let world = load_world(&SceneRequest {
         scene: args.scene.as_deref(),
-        defines: &args.define,
+        defines: &args.scene_flags.define,
         resolution: args.resolution,
         default_resolution: (640, 360),
-        strict: args.strict,
+        strict: args.scene_flags.strict,
     })?;
     let integrator = integrator(&args, &world)?;
     let samples_per_pixel = args.spp.unwrap_or(world.sample_count);
