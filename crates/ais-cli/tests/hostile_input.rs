@@ -348,3 +348,42 @@ fn compare_with_one_seed_or_a_black_scene_still_reports() {
         );
     }
 }
+
+#[test]
+fn gather_settings_and_property_values_are_checked() {
+    let dir = scratch("settings");
+    let out = dir.join("out.exr");
+    let out = out.to_str().unwrap();
+    let typo = scene(
+        &dir,
+        r#"<integrator type="gather"><integer name="rayz" value="8"/></integrator><shape type="sphere"/>"#,
+    );
+    refused(
+        &["render", &typo, "-o", out],
+        r#"unknown gather parameter "rayz""#,
+    );
+    refused(
+        &[
+            "render",
+            "--ais",
+            "shared",
+            "--sharing",
+            "pass:0",
+            "-o",
+            out,
+        ],
+        "S in 1..=16",
+    );
+    let ior = scene(
+        &dir,
+        r#"<shape type="sphere"><bsdf type="roughplastic"><float name="int_ior" value="-1.5"/></bsdf></shape>"#,
+    );
+    let output = ais(&["render", &ior, "-o", out, "--quiet"]);
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    assert!(output.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(r#""int_ior" = -1.5 must be positive"#),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("Float("), "{stderr}");
+}
