@@ -144,13 +144,7 @@ fn run_integrator(
         (Some(gather), true, false) => {
             let output = render(world, &Oracle(gather), settings);
             Ok(Rendered {
-                output: RenderOutput {
-                    image: output.image,
-                    rays: output.rays,
-                    stats: GatherStats::default(),
-                    work_per_sample: output.work_per_sample,
-                    time: output.time,
-                },
+                output: output.map_stats(|_| GatherStats::default()),
                 ais_time: None,
             })
         }
@@ -158,13 +152,7 @@ fn run_integrator(
             let output = render(world, &TimedGather(gather), settings);
             Ok(Rendered {
                 ais_time: Some(output.stats.ais_time),
-                output: RenderOutput {
-                    image: output.image,
-                    rays: output.rays,
-                    stats: output.stats.gather,
-                    work_per_sample: output.work_per_sample,
-                    time: output.time,
-                },
+                output: output.map_stats(|stats| stats.gather),
             })
         }
         (_, false, false) => Ok(Rendered {

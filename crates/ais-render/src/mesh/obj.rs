@@ -7,12 +7,8 @@ use std::path::Path;
 
 /// Refuses faces of fewer than three vertices, naming their line (tobj would turn them into
 /// degenerate triangles, and the error would blame the geometry).
-fn check_faces(path: &Path) -> Result<(), InputError> {
-    use std::io::BufRead;
-    let file = std::fs::File::open(path)
-        .map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
-    for (number, line) in std::io::BufReader::new(file).split(b'\n').enumerate() {
-        let line = line.map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
+fn check_faces(path: &Path, bytes: &[u8]) -> Result<(), InputError> {
+    for (number, line) in bytes.split(|&b| b == b'\n').enumerate() {
         let mut words = line
             .split(|b| b.is_ascii_whitespace())
             .filter(|w| !w.is_empty());
@@ -30,16 +26,21 @@ fn check_faces(path: &Path) -> Result<(), InputError> {
     Ok(())
 }
 
-/// Reads every object of an OBJ file into one mesh (polygons are triangulated).
+/// Reads every object of an OBJ file into one mesh (polygons are triangulated). The file is
+/// read once; its materials are not needed.
 pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
-    check_faces(path)?;
+    let bytes =
+        std::fs::read(path).map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
+    check_faces(path, &bytes)?;
     let options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
-    let (models, _) = tobj::load_obj(path, &options)
-        .map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
+    let (models, _) = tobj::load_obj_buf(&mut bytes.as_slice(), &options, |_| {
+        Err(tobj::LoadError::OpenFileFailed)
+    })
+    .map_err(|e| InputError::new(path, format!("cannot read OBJ: {e}")))?;
     let mut mesh = TriangleMesh::default();
     let mut all_have_normals = true;
     let mut normals = Vec::new();

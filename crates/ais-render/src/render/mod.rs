@@ -47,6 +47,19 @@ pub struct RenderOutput<S> {
     pub time: Duration,
 }
 
+impl<S> RenderOutput<S> {
+    /// The same render with its statistics turned into `T` (e.g. a study's own).
+    pub fn map_stats<T>(self, f: impl FnOnce(S) -> T) -> RenderOutput<T> {
+        RenderOutput {
+            image: self.image,
+            rays: self.rays,
+            stats: f(self.stats),
+            work_per_sample: self.work_per_sample,
+            time: self.time,
+        }
+    }
+}
+
 /// What one tile's render produced.
 struct TileResult<S> {
     rect: PixelRect,

@@ -18,7 +18,7 @@ pub mod report;
 use crate::oracle::Oracle;
 use ais::rng::mix64;
 use ais_render::image_io::RgbImage;
-use ais_render::integrators::gather::{GatherSettings, Preset, Strategy};
+use ais_render::integrators::gather::{GatherSettings, GatherStats, Preset, Strategy};
 use ais_render::integrators::Integrator;
 use ais_render::render::{render, RayCounts, RenderSettings};
 use ais_render::world::World;
@@ -82,27 +82,17 @@ impl Configuration {
             seed,
             progress: false,
         };
-        match self.technique {
-            Technique::Gather => {
-                let output = render(world, &Integrator::Gather(self.settings), &settings);
-                Pass {
-                    image: output.image,
-                    seconds: output.time.as_secs_f64(),
-                    rays: output.rays,
-                    stats: output.stats.ais,
-                    ais_memory_per_thread: output.stats.memory_per_thread,
-                }
-            }
-            Technique::Oracle => {
-                let output = render(world, &Oracle(self.settings), &settings);
-                Pass {
-                    image: output.image,
-                    seconds: output.time.as_secs_f64(),
-                    rays: output.rays,
-                    stats: ais::Stats::default(),
-                    ais_memory_per_thread: 0,
-                }
-            }
+        let output = match self.technique {
+            Technique::Gather => render(world, &Integrator::Gather(self.settings), &settings),
+            Technique::Oracle => render(world, &Oracle(self.settings), &settings)
+                .map_stats(|_| GatherStats::default()),
+        };
+        Pass {
+            image: output.image,
+            seconds: output.time.as_secs_f64(),
+            rays: output.rays,
+            stats: output.stats.ais,
+            ais_memory_per_thread: output.stats.memory_per_thread,
         }
     }
 }
