@@ -122,15 +122,6 @@ fn synthetic_envmap_with_a_tiny_sun_fits() {
     )));
     let p = fit(200_000, 1, |u| Some(env.sample(u)), |d| env.pdf(d));
     assert!(p > SIGNIFICANCE, "p = {p}");
-    // Inversion: the u that produced a direction maps back to it.
-    let mut rng = Pcg32::new(2, 2);
-    for _ in 0..1000 {
-        let u = [rng.next_f32(), rng.next_f32()];
-        let (d, _) = env.sample(u);
-        let back = env.invert(d).unwrap();
-        let (d2, _) = env.sample([back[0] as f32, back[1] as f32]);
-        assert!((d - d2).length() < 1e-3, "{d:?} vs {d2:?}");
-    }
 }
 
 /// The environment drawn from its product with a fixed affinity map (guided gathers): alone

@@ -18,6 +18,7 @@
 //!   blending;
 //! - [`shared`]: maps blended from neighbouring gathers, held fixed for a batch;
 //! - [`mapping`]: lat-long direction ↔ texel;
+//! - [`fast_trig`]: f32 atan2 and acos within 4e-7 rad, for per-candidate lookups;
 //! - [`sampling`]: warps and piecewise-constant distributions (sample, pdf, invert), including
 //!   a density over a map's texels to fold a fixed map into a proposal;
 //! - [`stats`]: counters; [`value`]: what a batch can average; [`rng`]: a seedable PCG32 and
@@ -41,6 +42,7 @@ pub mod affinity_map;
 pub mod analytic;
 pub mod batch;
 pub(crate) mod epochs;
+pub mod fast_trig;
 pub(crate) mod halton;
 pub mod mapping;
 pub mod rng;

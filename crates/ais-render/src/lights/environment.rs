@@ -9,12 +9,17 @@
 //!
 //! Sampling is piecewise constant in solid angle over the cells between four neighbouring
 //! texel centres, each weighted by the mean luminance of its corners times its solid angle,
-//! so the density is positive wherever the interpolated radiance is.
+//! so the density is positive wherever the interpolated radiance is. Both the row and the
+//! cell within it are drawn by alias tables, and each cell's density is stored, so that a
+//! sample, a density and a radiance lookup each cost O(1) whatever the image size. Like
+//! Mitsuba's RGB variants, all of it is f32; directions are located with [`fast_trig`],
+//! within 4e-7 rad of libm.
 
 use crate::image_io::RgbImage;
-use ais::sampling::uniform_sphere;
-use ais::sampling::Distribution2D;
-use glam::{DMat3, DVec3, Vec3};
+use ais::fast_trig;
+use ais::sampling::{uniform_sphere, AliasTable};
+use glam::{DMat3, Mat3, Vec3};
+use std::f32::consts::PI as PI32;
 use std::f64::consts::PI;
 
 /// Luminance of linear sRGB / Rec. 709 RGB.
@@ -31,20 +36,32 @@ pub enum Environment {
     Map(Box<EnvironmentMap>),
 }
 
-/// A lat-long environment image with its sampling distribution.
+/// A lat-long environment image with its sampling tables.
 #[derive(Clone, Debug)]
 pub struct EnvironmentMap {
     image: RgbImage,
-    to_world: DMat3,
-    to_local: DMat3,
-    /// Over `width × (height − 1)` cells; cell (c, r) has texel centres (c, r) and
-    /// (c + 1, r + 1) at its corners.
-    distribution: Distribution2D,
+    to_world: Mat3,
+    to_local: Mat3,
+    /// The `height − 1` rows of cells by probability. Cell (c, r) has texel centres (c, r)
+    /// and (c + 1, r + 1) at its corners.
+    rows: AliasTable,
+    /// For each row, its `width` cells by probability within the row.
+    columns: Vec<AliasTable>,
+    /// The sampling density of each cell in solid angle (row-major, `width × (height − 1)`).
+    cell_density: Vec<f32>,
     /// cos θ of each texel row.
-    row_cosines: Vec<f64>,
+    row_cosines: Vec<f32>,
     mean_luminance: f64,
     /// Its cells grouped by map texels, for guided light sampling.
     partitions: super::environment_guide::PartitionCache,
+}
+
+/// Where a direction falls on an environment map: Mitsuba's (u, v) and the sampling cell.
+#[derive(Clone, Copy, Debug)]
+struct MapLocation {
+    u: f32,
+    v: f32,
+    cell: usize,
 }
 
 impl EnvironmentMap {
@@ -59,100 +76,95 @@ impl EnvironmentMap {
         let row_cosines: Vec<f64> = (0..height)
             .map(|row| (PI * row as f64 / (height - 1) as f64).cos())
             .collect();
-        let texel_luminance = |column: usize, row: usize| {
-            luminance(Vec3::from(image.pixels[row * width + column % width])) as f64
-        };
-        let mut weights = Vec::with_capacity(width * (height - 1));
-        let mut integral = 0.0;
-        for row in 0..height - 1 {
-            let cell_solid_angle =
-                2.0 * PI / width as f64 * (row_cosines[row] - row_cosines[row + 1]);
-            for column in 0..width {
-                let corners = texel_luminance(column, row)
-                    + texel_luminance(column + 1, row)
-                    + texel_luminance(column, row + 1)
-                    + texel_luminance(column + 1, row + 1);
-                weights.push(corners / 4.0 * cell_solid_angle);
-                integral += corners / 4.0 * cell_solid_angle;
-            }
-        }
+        let cell_solid_angle =
+            |row: usize| 2.0 * PI / width as f64 * (row_cosines[row] - row_cosines[row + 1]);
+        let weights = cell_weights(&image, &row_cosines);
+        let total: f64 = weights.iter().sum();
+        let columns: Vec<AliasTable> = weights.chunks_exact(width).map(AliasTable::new).collect();
+        let rows = AliasTable::new(&columns.iter().map(AliasTable::total).collect::<Vec<_>>());
+        let cell_density = weights
+            .iter()
+            .enumerate()
+            .map(|(cell, &w)| {
+                let probability = if total > 0.0 {
+                    w / total
+                } else {
+                    1.0 / weights.len() as f64
+                };
+                (probability / cell_solid_angle(cell / width)) as f32
+            })
+            .collect();
         EnvironmentMap {
-            distribution: Distribution2D::new(&weights, width, height - 1),
-            to_local: to_world.inverse(),
-            to_world,
+            rows,
+            columns,
+            cell_density,
+            to_local: to_world.inverse().as_mat3(),
+            to_world: to_world.as_mat3(),
             image,
-            row_cosines,
-            mean_luminance: integral / (4.0 * PI),
+            row_cosines: row_cosines.iter().map(|&c| c as f32).collect(),
+            mean_luminance: total / (4.0 * PI),
             partitions: Default::default(),
         }
     }
 
-    /// Mitsuba's (u, v) of a world direction: u ∈ [0, 1), v ∈ [0, 1].
-    fn uv(&self, direction: Vec3) -> [f64; 2] {
-        let d = self.to_local * direction.as_dvec3();
-        let mut u = d.x.atan2(-d.z) / (2.0 * PI);
+    /// Where `direction` (unit, world space) falls: Mitsuba's u = atan2(x, −z) / 2π ∈ [0, 1)
+    /// and v = acos(y) / π ∈ [0, 1] in the emitter's frame, and the sampling cell there.
+    #[inline]
+    fn locate(&self, direction: Vec3) -> MapLocation {
+        let d = self.to_local * direction;
+        let mut u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI32);
         if u < 0.0 {
             u += 1.0;
         }
-        [u.min(1.0 - f64::EPSILON), d.y.clamp(-1.0, 1.0).acos() / PI]
+        let u = u.min(ONE_BELOW);
+        let v = fast_trig::acos(d.y) * (1.0 / PI32);
+        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
+        // Cells start half a texel after u = 0 (their corners are texel centres).
+        let mut x = u * width as f32 - 0.5;
+        if x < 0.0 {
+            x += width as f32;
+        }
+        let column = (x as usize).min(width - 1);
+        let row = ((v * rows as f32) as usize).min(rows - 1);
+        MapLocation {
+            u,
+            v,
+            cell: row * width + column,
+        }
     }
 
-    /// Bilinear interpolation at (u, v) in Mitsuba's texel layout.
-    fn interpolate(&self, [u, v]: [f64; 2]) -> Vec3 {
+    /// Bilinear interpolation at Mitsuba's (u, v), in its texel layout.
+    #[inline]
+    fn interpolate(&self, location: MapLocation) -> Vec3 {
         let (width, height) = (self.image.width, self.image.height);
-        let x = u * width as f64 - 0.5;
+        let x = location.u * width as f32 - 0.5;
         let x0 = x.floor();
-        let fx = (x - x0) as f32;
+        let fx = x - x0;
         let c0 = (x0 as i64).rem_euclid(width as i64) as usize;
-        let c1 = (c0 + 1) % width;
-        let y = v.clamp(0.0, 1.0) * (height - 1) as f64;
-        let r0 = (y.floor() as usize).min(height - 2);
-        let fy = (y - r0 as f64) as f32;
+        let c1 = if c0 + 1 == width { 0 } else { c0 + 1 };
+        let y = location.v.clamp(0.0, 1.0) * (height - 1) as f32;
+        let r0 = (y as usize).min(height - 2);
+        let fy = y - r0 as f32;
         let texel = |c: usize, r: usize| Vec3::from(self.image.pixels[r * width + c]);
         let top = texel(c0, r0).lerp(texel(c1, r0), fx);
         let bottom = texel(c0, r0 + 1).lerp(texel(c1, r0 + 1), fx);
         top.lerp(bottom, fy)
     }
 
-    /// The distribution's cell coordinates of (u, v), and the cell row's cos θ span.
-    fn cell_coordinates(&self, [u, v]: [f64; 2]) -> ([f64; 2], f64) {
-        let (width, rows) = (self.image.width as f64, self.row_cosines.len() - 1);
-        let x = (u - 0.5 / width).rem_euclid(1.0);
-        let row = ((v * rows as f64) as usize).min(rows - 1);
-        let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
-        let cos_theta = (PI * v).cos();
-        let t = ((top - cos_theta) / (top - bottom)).clamp(0.0, 1.0);
-        (
-            [x.min(1.0 - f64::EPSILON), (row as f64 + t) / rows as f64],
-            top - bottom,
-        )
+    /// A direction drawn from `u` and its density in solid angle: a row of cells, a cell in
+    /// it, then a point uniform in φ and cos θ within the cell, so the density is the cell's.
+    #[inline]
+    pub(crate) fn sample(&self, u: [f32; 2]) -> (Vec3, f32) {
+        let (row, fy) = self.rows.sample(u[1]);
+        let (column, fx) = self.columns[row].sample(u[0]);
+        let cell = row * self.image.width + column;
+        (self.direction_in_cell(cell, [fx, fy]), self.cell_density[cell])
     }
 
-    /// A direction drawn from `u` and its density in solid angle.
-    pub(crate) fn sample(&self, u: [f64; 2]) -> (Vec3, f64) {
-        let ([x, y], pdf_cells) = self.distribution.sample(u);
-        let (direction, span) = self.direction_at([x, y]);
-        // Cells are uniform in φ and cos θ, so the density is constant within each.
-        let rows = self.row_cosines.len() - 1;
-        (direction, pdf_cells / (rows as f64 * 2.0 * PI * span))
-    }
-
-    /// The world direction at the distribution's cell coordinates (x, y) ∈ [0, 1)², and the
-    /// cos θ span of its cell row.
-    fn direction_at(&self, [x, y]: [f64; 2]) -> (Vec3, f64) {
-        let rows = self.row_cosines.len() - 1;
-        let row = ((y * rows as f64) as usize).min(rows - 1);
-        let t = y * rows as f64 - row as f64;
-        let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
-        let cos_theta = (top + t * (bottom - top)).clamp(-1.0, 1.0);
-        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = (2.0 * PI * (x + 0.5 / self.image.width as f64)).sin_cos();
-        let local = DVec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
-        ((self.to_world * local).normalize().as_vec3(), top - bottom)
-    }
-
-    fn pdf(&self, direction: Vec3) -> f64 {
-        self.pdf_and_cell(direction).0
+    /// The sampling density at `direction`, in solid angle.
+    #[inline]
+    fn pdf(&self, direction: Vec3) -> f32 {
+        self.cell_density[self.locate(direction).cell]
     }
 
     /// Its cells grouped by the texels of `layout` (built once, then shared).
@@ -176,14 +188,13 @@ impl EnvironmentMap {
 
     /// Number of sampling cells (`width × (height − 1)`, row-major).
     pub(crate) fn cell_count(&self) -> usize {
-        self.image.width * (self.row_cosines.len() - 1)
+        self.cell_density.len()
     }
 
     /// Probability that sampling picks `cell`.
     pub(crate) fn cell_probability(&self, cell: usize) -> f64 {
-        let width = self.image.width;
-        self.distribution
-            .cell_probability(cell % width, cell / width)
+        let (column, row) = (cell % self.image.width, cell / self.image.width);
+        self.rows.probability(row) as f64 * self.columns[row].probability(column) as f64
     }
 
     /// The world direction through the centre of `cell`.
@@ -193,31 +204,57 @@ impl EnvironmentMap {
 
     /// The direction at fractions (`fx`, `fy`) ∈ [0, 1)² of `cell`'s azimuth and cos θ range:
     /// with uniform fractions, uniform in solid angle over the cell, as sampling draws.
-    pub(crate) fn direction_in_cell(&self, cell: usize, [fx, fy]: [f64; 2]) -> Vec3 {
-        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
-        let x = ((cell % width) as f64 + fx) / width as f64;
-        let y = ((cell / width) as f64 + fy) / rows as f64;
-        self.direction_at([x.min(1.0 - f64::EPSILON), y.min(1.0 - f64::EPSILON)])
-            .0
+    #[inline]
+    pub(crate) fn direction_in_cell(&self, cell: usize, [fx, fy]: [f32; 2]) -> Vec3 {
+        let width = self.image.width;
+        let (column, row) = (cell % width, cell / width);
+        let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
+        let cos_theta = (top + fy * (bottom - top)).clamp(-1.0, 1.0);
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let phi = 2.0 * PI32 * (column as f32 + 0.5 + fx) / width as f32;
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let local = Vec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
+        (self.to_world * local).normalize()
     }
 
     /// The sampling density at `direction` (solid angle) and the cell it falls in.
-    pub(crate) fn pdf_and_cell(&self, direction: Vec3) -> (f64, usize) {
-        let ([x, y], span) = self.cell_coordinates(self.uv(direction));
-        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
-        let column = ((x * width as f64) as usize).min(width - 1);
-        let row = ((y * rows as f64) as usize).min(rows - 1);
-        let density = self.distribution.pdf([x, y]) / (rows as f64 * 2.0 * PI * span);
-        (density, row * width + column)
+    #[inline]
+    pub(crate) fn pdf_and_cell(&self, direction: Vec3) -> (f32, usize) {
+        let cell = self.locate(direction).cell;
+        (self.cell_density[cell], cell)
     }
 }
+
+/// Each cell's sampling weight: the mean luminance of its four corner texels times its
+/// solid angle, so the density is positive wherever the interpolated radiance is.
+fn cell_weights(image: &RgbImage, row_cosines: &[f64]) -> Vec<f64> {
+    let (width, height) = (image.width, image.height);
+    let texel_luminance = |column: usize, row: usize| {
+        luminance(Vec3::from(image.pixels[row * width + column % width])) as f64
+    };
+    let mut weights = Vec::with_capacity(width * (height - 1));
+    for row in 0..height - 1 {
+        let cell_solid_angle = 2.0 * PI / width as f64 * (row_cosines[row] - row_cosines[row + 1]);
+        for column in 0..width {
+            let corners = texel_luminance(column, row)
+                + texel_luminance(column + 1, row)
+                + texel_luminance(column, row + 1)
+                + texel_luminance(column + 1, row + 1);
+            weights.push(corners / 4.0 * cell_solid_angle);
+        }
+    }
+    weights
+}
+
+/// The largest f32 below 1.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 impl Environment {
     /// Radiance arriving from `direction` (unit, world space).
     pub fn radiance(&self, direction: Vec3) -> Vec3 {
         match self {
             Environment::Constant(radiance) => *radiance,
-            Environment::Map(map) => map.interpolate(map.uv(direction)),
+            Environment::Map(map) => map.interpolate(map.locate(direction)),
         }
     }
 
@@ -225,7 +262,10 @@ impl Environment {
     pub fn sample(&self, u: [f32; 2]) -> (Vec3, f64) {
         match self {
             Environment::Constant(_) => (uniform_sphere(u), 1.0 / (4.0 * PI)),
-            Environment::Map(map) => map.sample([u[0] as f64, u[1] as f64]),
+            Environment::Map(map) => {
+                let (direction, density) = map.sample(u);
+                (direction, density as f64)
+            }
         }
     }
 
@@ -233,18 +273,7 @@ impl Environment {
     pub fn pdf(&self, direction: Vec3) -> f64 {
         match self {
             Environment::Constant(_) => 1.0 / (4.0 * PI),
-            Environment::Map(map) => map.pdf(direction),
-        }
-    }
-
-    /// The `u` that [`Environment::sample`] maps to `direction` (environment maps only).
-    pub fn invert(&self, direction: Vec3) -> Option<[f64; 2]> {
-        match self {
-            Environment::Constant(_) => None,
-            Environment::Map(map) => {
-                let (cell, _) = map.cell_coordinates(map.uv(direction));
-                Some(map.distribution.invert(cell))
-            }
+            Environment::Map(map) => map.pdf(direction) as f64,
         }
     }
 

@@ -197,8 +197,8 @@ impl EnvironmentGuide {
         let beta = self.fraction;
         let u0 = u[0] as f64;
         if u0 >= beta {
-            let rescaled = ((u0 - beta) / (1.0 - beta)).clamp(0.0, 1.0 - 1e-9);
-            return environment.sample([rescaled, u[1] as f64]).0;
+            let rescaled = ((u0 - beta) / (1.0 - beta)).clamp(0.0, 1.0 - 1e-7);
+            return environment.sample([rescaled as f32, u[1]]).0;
         }
         let u0 = u0 / beta;
         let texels = self.affinity.len();
@@ -216,9 +216,9 @@ impl EnvironmentGuide {
             i -= 1;
         }
         let below = if i == 0 { 0.0 } else { within[i - 1] };
-        let fx = ((v - below) / (within[i] - below)).clamp(0.0, 1.0 - 1e-9);
+        let fx = ((v - below) / (within[i] - below)).clamp(0.0, 1.0 - 1e-7) as f32;
         let cell = partition.cells[range.start + i] as usize;
-        environment.direction_in_cell(cell, [fx, (u[1] as f64).min(1.0 - 1e-9)])
+        environment.direction_in_cell(cell, [fx, u[1].min(1.0 - 1e-7)])
     }
 
     /// The mixture's density at `direction` (solid angle).
@@ -226,6 +226,6 @@ impl EnvironmentGuide {
         let (density, cell) = environment.pdf_and_cell(direction);
         let product =
             self.affinity[self.partition.cell_texel[cell] as usize] as f64 / self.normaliser;
-        density * ((1.0 - self.fraction) + self.fraction * product)
+        density as f64 * ((1.0 - self.fraction) + self.fraction * product)
     }
 }

@@ -1,5 +1,5 @@
 //! All emitters of a scene: an optional environment and area lights, chosen in proportion
-//! to their estimated power for light sampling.
+//! to their estimated power for light sampling (an alias table: O(1) per choice).
 
 mod area;
 mod environment;
@@ -12,7 +12,7 @@ pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
 pub use spherical_rectangle::Rectangle;
 
 use crate::geometry::Ray;
-use ais::sampling::Distribution1D;
+use ais::sampling::AliasTable;
 use glam::Vec3;
 use std::f64::consts::PI;
 
@@ -26,7 +26,7 @@ pub struct Lights {
     /// For each geometry shape, its area light (index into `area`).
     pub shape_lights: Vec<Option<usize>>,
     /// Choice of a light: index 0..area.len() for area lights, area.len() for the environment.
-    choice: Option<Distribution1D>,
+    choice: Option<AliasTable>,
 }
 
 impl Lights {
@@ -46,7 +46,7 @@ impl Lights {
         if let Some(environment) = &environment {
             weights.push(PI * environment.mean_luminance() * PI * scene_radius * scene_radius);
         }
-        let choice = (!weights.is_empty()).then(|| Distribution1D::new(&weights));
+        let choice = (!weights.is_empty()).then(|| AliasTable::new(&weights));
         Lights {
             environment,
             area,
@@ -64,7 +64,7 @@ impl Lights {
     fn choice_probability(&self, index: usize) -> f64 {
         self.choice
             .as_ref()
-            .map_or(0.0, |c| c.bin_probability(index))
+            .map_or(0.0, |c| c.probability(index) as f64)
     }
 
     /// A direction from `point` drawn by light sampling: a light chosen in proportion to its
@@ -83,8 +83,7 @@ impl Lights {
         guide: Option<&EnvironmentGuide>,
     ) -> Option<Vec3> {
         let choice = self.choice.as_ref()?;
-        let (x, _, index) = choice.sample(u[0] as f64);
-        let u0 = ((x * choice.len() as f64 - index as f64).clamp(0.0, 1.0 - 1e-7)) as f32;
+        let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
             return Some(self.area[index].sample(point, [u0, u[1]])?.direction);
         }
