@@ -5,11 +5,15 @@
 
 writes scenes/assets/sky.hdr: a 256x128 lat-long sky in Mitsuba's orientation (+y up, u = 0
 toward -z), a horizon-bright blue gradient, a dim ground, and a small bright sun. The file is
-a flat (uncompressed) Radiance RGBE image. It also writes scenes/assets/blob.obj: a bumpy
-sphere of radius about 1 with 14,800 triangles, the sunlit room's mesh.
+a flat (uncompressed) Radiance RGBE image. It also writes, into the same folder:
+- blob.obj: a bumpy sphere of radius about 1 with 14,800 triangles, the sunlit room's mesh;
+- leaves.obj: 4,000 small square leaves (8,000 triangles) scattered with a fixed seed through
+  a slab 4 x 0.8 x 4 m, a canopy that occludes partly at every scale;
+- ball.obj: a smooth sphere of radius 1 with 7,920 triangles, an emitting mesh.
 """
 import math
 import os
+import random
 import struct
 
 WIDTH, HEIGHT = 256, 128
@@ -63,6 +67,10 @@ def write_blob(path):
                 lines.append(f"f {a} {b} {c}")
             if row < BLOB_ROWS - 1:
                 lines.append(f"f {a} {c} {d}")
+    write_obj(path, lines)
+
+
+def write_obj(path, lines):
     temporary = path + ".tmp"
     with open(temporary, "w") as f:
         f.write("\n".join(lines) + "\n")
@@ -70,10 +78,68 @@ def write_blob(path):
     print(f"wrote {path}")
 
 
+LEAVES, LEAF_SIZE = 4000, 0.09
+
+
+def write_leaves(path):
+    """Square leaves of side LEAF_SIZE, random centres in [-2, 2] x [0, 0.8] x [-2, 2] and
+    random orientations (seed 7), each two triangles."""
+    rng = random.Random(7)
+    lines = []
+    for leaf in range(LEAVES):
+        centre = (rng.uniform(-2, 2), rng.uniform(0, 0.8), rng.uniform(-2, 2))
+        normal = [rng.gauss(0, 1) for _ in range(3)]
+        length = math.sqrt(sum(c * c for c in normal)) or 1.0
+        normal = [c / length for c in normal]
+        helper = (1.0, 0.0, 0.0) if abs(normal[0]) < 0.9 else (0.0, 1.0, 0.0)
+        a = [helper[1] * normal[2] - helper[2] * normal[1], helper[2] * normal[0] - helper[0] * normal[2],
+             helper[0] * normal[1] - helper[1] * normal[0]]
+        length = math.sqrt(sum(c * c for c in a))
+        a = [c / length for c in a]
+        b = [normal[1] * a[2] - normal[2] * a[1], normal[2] * a[0] - normal[0] * a[2],
+             normal[0] * a[1] - normal[1] * a[0]]
+        h = LEAF_SIZE / 2
+        for sa, sb in ((-1, -1), (1, -1), (1, 1), (-1, 1)):
+            x, y, z = (centre[i] + h * (sa * a[i] + sb * b[i]) for i in range(3))
+            lines.append(f"v {x:.6f} {y:.6f} {z:.6f}")
+        first = 4 * leaf + 1
+        lines.append(f"f {first} {first + 1} {first + 2}")
+        lines.append(f"f {first} {first + 2} {first + 3}")
+    write_obj(path, lines)
+
+
+BALL_COLUMNS, BALL_ROWS = 60, 67
+
+
+def write_ball(path):
+    """A UV sphere of radius 1 with outward winding: 2 x 60 x 66 triangles."""
+    lines = []
+    for row in range(BALL_ROWS + 1):
+        theta = math.pi * row / BALL_ROWS
+        for column in range(BALL_COLUMNS):
+            phi = 2.0 * math.pi * column / BALL_COLUMNS
+            lines.append(f"v {math.sin(theta) * math.cos(phi):.6f} {math.cos(theta):.6f} "
+                         f"{math.sin(theta) * math.sin(phi):.6f}")
+
+    def index(row, column):
+        return row * BALL_COLUMNS + column % BALL_COLUMNS + 1
+    for row in range(BALL_ROWS):
+        for column in range(BALL_COLUMNS):
+            a, b = index(row, column), index(row, column + 1)
+            c, d = index(row + 1, column + 1), index(row + 1, column)
+            if row > 0:
+                lines.append(f"f {a} {b} {c}")
+            if row < BALL_ROWS - 1:
+                lines.append(f"f {a} {c} {d}")
+    write_obj(path, lines)
+
+
 def main():
     folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "assets")
     os.makedirs(folder, exist_ok=True)
     write_blob(os.path.join(folder, "blob.obj"))
+    write_leaves(os.path.join(folder, "leaves.obj"))
+    write_ball(os.path.join(folder, "ball.obj"))
     path = os.path.join(folder, "sky.hdr")
     rows = []
     for row in range(HEIGHT):

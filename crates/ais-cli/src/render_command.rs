@@ -361,4 +361,12 @@ fn print_gather_summary(
         "AIS memory   {:.1} KiB per thread (maps, shared maps, guides)",
         rendered.output.stats.memory_per_thread as f64 / 1024.0
     );
+    let [rolled, aside] = rendered.output.stats.field_gathers;
+    if rolled + aside > 0 {
+        println!(
+            "field        {:.1} KiB; roulette in {:.1}% of gathers, stood aside in the rest",
+            rendered.output.stats.field_memory as f64 / 1024.0,
+            100.0 * rolled as f64 / (rolled + aside) as f64
+        );
+    }
 }

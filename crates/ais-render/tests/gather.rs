@@ -18,7 +18,7 @@ const STRATEGIES: [Strategy; 4] = [
     Strategy::Light,
     Strategy::Mis,
 ];
-const MODES: [Preset; 6] = Preset::ALL;
+const MODES: [Preset; 7] = Preset::ALL;
 
 /// Statistics of the gather with `gather` settings.
 fn pixel_statistics(

@@ -2,7 +2,7 @@
 //! model from npm (the Stanford bunny).
 
 use ais_render::default_scene::default_world;
-use ais_render::integrators::gather::GatherStats;
+use ais_render::integrators::gather::{self, GatherStats};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Sharing};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
 use ais_render::render::{render, RenderOutput, RenderSettings};
@@ -74,6 +74,34 @@ fn images_are_bit_identical_at_one_and_two_threads() {
         bits(&per_batch.image),
         "the guide changes the proposal"
     );
+}
+
+#[test]
+fn the_learned_field_is_thread_independent_and_used() {
+    // Two passes of 1 spp: the field learned in the first is fixed for the second, and
+    // merged from integer counts, so the image cannot depend on the threads.
+    let world = default_world(48, 27);
+    let auto = Integrator::Gather(GatherSettings::preset(Preset::Auto));
+    let one = on_threads(&world, 1, auto);
+    let two = on_threads(&world, 2, auto);
+    assert_eq!(bits(&one.image), bits(&two.image));
+    assert_eq!(one.stats.ais, two.stats.ais);
+    assert_eq!(one.stats.field_gathers, two.stats.field_gathers);
+    let [rolled, aside] = one.stats.field_gathers;
+    assert!(
+        rolled > 0 && aside > 0,
+        "{rolled} gathers used the field, {aside} did not"
+    );
+    assert!(one.stats.ais.rejected_roulette > 0, "the field rejects");
+    assert!(one.stats.field_memory > 0);
+}
+
+#[test]
+fn field_passes_double_after_two_single_sample_passes() {
+    assert_eq!(gather::field_passes(4), vec![1, 1, 2]);
+    assert_eq!(gather::field_passes(64), vec![1, 1, 2, 4, 8, 16, 32]);
+    assert_eq!(gather::field_passes(5), vec![1, 1, 2, 1]);
+    assert_eq!(gather::field_passes(1), vec![1]);
 }
 
 #[test]

@@ -49,6 +49,9 @@ pub struct OracleTile {
 
 impl TileState for OracleTile {
     type Stats = OracleStats;
+    type Observed = ();
+
+    fn take_observed(&mut self) {}
 
     fn finish(self) -> OracleStats {
         self.stats
@@ -56,9 +59,10 @@ impl TileState for OracleTile {
 }
 
 impl SampleIntegrator for Oracle {
+    type Learned = ();
     type Tile = OracleTile;
 
-    fn begin_tile(&self, _: &World, _: &Tile, _: &mut RayCounts) -> OracleTile {
+    fn begin_tile(&self, _: &World, _: &Tile, _: &(), _: &mut RayCounts) -> OracleTile {
         OracleTile::default()
     }
 

@@ -6,12 +6,14 @@
 //! in between, and that replay is timed as one region. The batch is deterministic, so the
 //! replay takes the same path; the image is not affected (the replay uses its own driver).
 
+use ais::field::FieldObservations;
 use ais::rng::Pcg32;
 use ais::{Batch, BatchConfig, Decision, MapStart};
 use ais_render::geometry::Ray;
 use ais_render::integrators::gather::{
-    gather, BatchProbe, GatherSettings, GatherStats, GatherTile,
+    gather, BatchProbe, GatherLearning, GatherSettings, GatherStats, GatherTile,
 };
+use ais_render::integrators::Integrator;
 use ais_render::render::{RayCounts, SampleIntegrator, Tile, TileState, TileStats};
 use ais_render::world::World;
 use glam::Vec3;
@@ -137,6 +139,11 @@ impl TileStats for TimedStats {
 
 impl TileState for TimedTile {
     type Stats = TimedStats;
+    type Observed = Option<FieldObservations>;
+
+    fn take_observed(&mut self) -> Option<FieldObservations> {
+        self.0.take_observed()
+    }
 
     fn work(&self) -> u64 {
         self.0.work()
@@ -152,13 +159,25 @@ impl TileState for TimedTile {
 }
 
 impl SampleIntegrator for TimedGather {
+    type Learned = GatherLearning;
     type Tile = TimedTile;
 
-    fn begin_tile(&self, world: &World, tile: &Tile, counts: &mut RayCounts) -> TimedTile {
+    fn passes(&self, spp: u32) -> Vec<u32> {
+        Integrator::Gather(self.0).passes(spp)
+    }
+
+    fn begin_tile(
+        &self,
+        world: &World,
+        tile: &Tile,
+        learned: &GatherLearning,
+        counts: &mut RayCounts,
+    ) -> TimedTile {
         TimedTile(GatherTile::begin(
             world,
             &self.0,
             tile,
+            learned,
             counts,
             AisTimer::default(),
         ))

@@ -43,20 +43,38 @@ impl<const BASE: usize, const DIGITS: usize> DigitScramble<BASE, DIGITS> {
         }
     }
 
-    fn randomize(&mut self, rng: &mut Pcg32) {
-        for permutation in self.permutations.iter_mut() {
+    /// Draws the permutations of the first `used` digit positions, and for the positions
+    /// beyond (where every index of the epoch has the digit 0) only what they add: the
+    /// permuted zeros, a uniform offset below `BASE^-used` (the limit of drawing each of them).
+    fn randomize(&mut self, rng: &mut Pcg32, used: usize) {
+        let used = used.min(DIGITS);
+        for permutation in self.permutations[..used].iter_mut() {
             // Fisher-Yates shuffle of the digits.
             for i in (1..BASE).rev() {
                 let j = rng.below(i as u32 + 1) as usize;
                 permutation.swap(i, j);
             }
         }
-        let mut sum = 0.0;
         let inverse_base = 1.0 / BASE as f64;
-        for position in (0..DIGITS).rev() {
+        let mut sum = rng.next_f64() * inverse_base.powi(used as i32);
+        if used < DIGITS {
+            self.tail[used] = sum;
+        }
+        for position in (0..used).rev() {
             sum += self.permutations[position][0] as f64 * inverse_base.powi(position as i32 + 1);
             self.tail[position] = sum;
         }
+    }
+
+    /// How many digit positions the indices `0..count` use.
+    fn digits_for(count: u32) -> usize {
+        let mut digits = 0;
+        let mut reach = 1u64;
+        while reach < count as u64 {
+            reach *= BASE as u64;
+            digits += 1;
+        }
+        digits
     }
 
     #[inline]
@@ -109,18 +127,27 @@ impl ScrambledHalton {
     #[cfg(test)]
     pub fn scrambled(seed: u64) -> Self {
         let mut sequence = Self::unscrambled();
-        sequence.rescramble(seed);
+        sequence.rescramble(seed, u32::MAX);
         sequence
     }
 
-    /// Draws fresh digit permutations from `seed`, in place (no allocation).
-    pub fn rescramble(&mut self, seed: u64) {
+    /// Draws fresh digit permutations from `seed` for the points `0..count`, in place (no
+    /// allocation). Only the digit positions those indices reach get a full permutation,
+    /// which is what makes a scramble cheap for a small batch; points beyond `count` keep
+    /// their stratification but are not independently scrambled.
+    pub fn rescramble(&mut self, seed: u64, count: u32) {
         let mut rng = Pcg32::new(seed, 0x4841_4c54_4f4e); // stream "HALTON"
         self.base2_mask = rng.next_u32();
         self.base3 = DigitScramble::identity();
-        self.base3.randomize(&mut rng);
+        self.base3.randomize(
+            &mut rng,
+            DigitScramble::<3, DIGITS_BASE3>::digits_for(count),
+        );
         self.base5 = DigitScramble::identity();
-        self.base5.randomize(&mut rng);
+        self.base5.randomize(
+            &mut rng,
+            DigitScramble::<5, DIGITS_BASE5>::digits_for(count),
+        );
     }
 
     /// The `index`-th point, each coordinate in [0, 1).
@@ -240,6 +267,43 @@ mod tests {
         }
         for s in sum {
             assert!((s / n as f64 - 0.5).abs() < 0.01, "mean {}", s / n as f64);
+        }
+    }
+
+    #[test]
+    fn a_scramble_for_a_few_points_is_stratified_and_uniform() {
+        // Scrambling only the digits that 16 points reach: every point is still uniform over
+        // seeds (tested on a fine grid, which the random tail offset must fill), and the
+        // prefix blocks stay stratified.
+        let n = 30_000;
+        let mut histogram = vec![[0u32; 3]; 64];
+        for seed in 0..n {
+            let mut h = ScrambledHalton::unscrambled();
+            h.rescramble(seed, 16);
+            let points: Vec<[f32; 3]> = (0..16).map(|i| h.point(i)).collect();
+            for (dim, base) in [(1usize, 3usize), (2, 5)] {
+                let mut hit = vec![false; base];
+                for p in &points[..base] {
+                    let cell = (p[dim] * base as f32) as usize;
+                    assert!(
+                        !hit[cell],
+                        "seed {seed}, dim {dim}: two points in cell {cell}"
+                    );
+                    hit[cell] = true;
+                }
+            }
+            for d in 0..3 {
+                histogram[(points[15][d] * 64.0) as usize][d] += 1;
+            }
+        }
+        for counts in histogram {
+            for count in counts {
+                let expected = n as f64 / 64.0;
+                assert!(
+                    (count as f64 - expected).abs() < 5.0 * expected.sqrt(),
+                    "{count}"
+                );
+            }
         }
     }
 }

@@ -17,6 +17,8 @@
 //! - [`affinity_map`]: the map's channels, update rules (aggressive, conservative) and
 //!   blending;
 //! - [`shared`]: maps blended from neighbouring gathers, held fixed for a batch;
+//! - [`field`]: a learned visibility field over the whole image, fixed during a pass, and
+//!   the acceptance it gives each candidate;
 //! - [`mapping`]: lat-long direction ↔ texel;
 //! - [`fast_trig`]: f32 atan2 and acos within 4e-7 rad, for per-candidate lookups;
 //! - [`sampling`]: warps and piecewise-constant distributions (sample, pdf, invert), including
@@ -43,6 +45,7 @@ pub mod analytic;
 pub mod batch;
 pub(crate) mod epochs;
 pub mod fast_trig;
+pub mod field;
 pub(crate) mod halton;
 pub mod mapping;
 pub mod rng;

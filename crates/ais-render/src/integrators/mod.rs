@@ -10,8 +10,9 @@ pub use ambient_occlusion::AmbientOcclusion;
 use crate::geometry::Ray;
 use crate::render::{RayCounts, SampleIntegrator, Tile, TileState};
 use crate::world::World;
+use ais::field::FieldObservations;
 use ais::rng::Pcg32;
-use gather::{GatherSettings, GatherStats, GatherTile};
+use gather::{GatherLearning, GatherSettings, GatherStats, GatherTile, MapSource};
 
 /// What to compute at each camera sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,6 +36,14 @@ pub enum IntegratorTile {
 
 impl TileState for IntegratorTile {
     type Stats = GatherStats;
+    type Observed = Option<FieldObservations>;
+
+    fn take_observed(&mut self) -> Option<FieldObservations> {
+        match self {
+            IntegratorTile::Gather(state) => state.take_observed(),
+            IntegratorTile::Stateless => None,
+        }
+    }
 
     fn work(&self) -> u64 {
         match self {
@@ -52,14 +61,31 @@ impl TileState for IntegratorTile {
 }
 
 impl SampleIntegrator for Integrator {
+    type Learned = GatherLearning;
     type Tile = IntegratorTile;
 
-    fn begin_tile(&self, world: &World, tile: &Tile, counts: &mut RayCounts) -> IntegratorTile {
+    fn passes(&self, spp: u32) -> Vec<u32> {
+        match self {
+            Integrator::Gather(settings) if settings.map == MapSource::Field => {
+                gather::field_passes(spp)
+            }
+            _ => vec![spp],
+        }
+    }
+
+    fn begin_tile(
+        &self,
+        world: &World,
+        tile: &Tile,
+        learned: &GatherLearning,
+        counts: &mut RayCounts,
+    ) -> IntegratorTile {
         match self {
             Integrator::Gather(settings) => IntegratorTile::Gather(Box::new(GatherTile::begin(
                 world,
                 settings,
                 tile,
+                learned,
                 counts,
                 (),
             ))),

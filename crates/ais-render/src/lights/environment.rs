@@ -158,7 +158,10 @@ impl EnvironmentMap {
         let (row, fy) = self.rows.sample(u[1]);
         let (column, fx) = self.columns[row].sample(u[0]);
         let cell = row * self.image.width + column;
-        (self.direction_in_cell(cell, [fx, fy]), self.cell_density[cell])
+        (
+            self.direction_in_cell(cell, [fx, fy]),
+            self.cell_density[cell],
+        )
     }
 
     /// The sampling density at `direction`, in solid angle.

@@ -17,10 +17,31 @@ impl TileStats for () {
     fn merge(&mut self, _: ()) {}
 }
 
+/// What an integrator learns over a render: state that every tile of a pass reads and
+/// that changes only between passes, from what the pass's tiles observed. Fixed within a
+/// pass, it keeps each pass unbiased and the image independent of threads.
+pub trait Learning: Default + Sync {
+    /// What one tile observed in a pass.
+    type Observed: Send;
+
+    /// Adds a tile's observations. The result must not depend on the order of tiles.
+    fn merge(&mut self, observed: Self::Observed);
+}
+
+impl Learning for () {
+    type Observed = ();
+    fn merge(&mut self, _: ()) {}
+}
+
 /// Per-tile state of an integrator.
 pub trait TileState {
     /// What the tile reports when it is done.
     type Stats: TileStats;
+    /// What it observed for the integrator's [`Learning`].
+    type Observed: Send;
+
+    /// Hands over what the tile observed in this pass.
+    fn take_observed(&mut self) -> Self::Observed;
 
     /// A counter of the integrator's own work that only grows (the gather's traced rays);
     /// the render reports its increase per camera sample, per pixel, as an AOV.
@@ -34,6 +55,8 @@ pub trait TileState {
 
 impl TileState for () {
     type Stats = ();
+    type Observed = ();
+    fn take_observed(&mut self) {}
     fn finish(self) {}
 }
 
@@ -41,12 +64,25 @@ impl TileState for () {
 /// state made fresh for every tile (so the image does not depend on threads or on the
 /// order of tiles).
 pub trait SampleIntegrator: Sync {
+    /// What it learns between passes (`()` for nothing).
+    type Learned: Learning<Observed = <Self::Tile as TileState>::Observed>;
     /// Per-tile state.
     type Tile: TileState;
 
-    /// The state for `tile`; work done here (a learning pass, say) counts its rays in
-    /// `counts`.
-    fn begin_tile(&self, world: &World, tile: &Tile, counts: &mut RayCounts) -> Self::Tile;
+    /// How `spp` samples per pixel split into passes (one pass unless it learns).
+    fn passes(&self, spp: u32) -> Vec<u32> {
+        vec![spp]
+    }
+
+    /// The state for `tile`, reading what was learned before this pass; work done here (a
+    /// learning pass, say) counts its rays in `counts`.
+    fn begin_tile(
+        &self,
+        world: &World,
+        tile: &Tile,
+        learned: &Self::Learned,
+        counts: &mut RayCounts,
+    ) -> Self::Tile;
 
     /// The value of one camera ray.
     fn radiance(

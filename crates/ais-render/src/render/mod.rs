@@ -3,14 +3,17 @@
 //!
 //! The tile loop knows nothing about what an integrator computes: it hands every tile a
 //! fresh state from the integrator ([`SampleIntegrator::begin_tile`]), asks it for the
-//! value of each camera ray, and merges the tiles' statistics.
+//! value of each camera ray, and merges the tiles' statistics. An integrator that learns
+//! renders in passes ([`SampleIntegrator::passes`]): after each pass the loop merges what
+//! the tiles observed into its [`Learning`], which the next pass reads. Pass 0 seeds each
+//! pixel's generator as a one-pass render does; later passes mix their index into the seed.
 
 mod counts;
 mod integrator;
 mod tile;
 
 pub use counts::RayCounts;
-pub use integrator::{SampleIntegrator, TileState, TileStats};
+pub use integrator::{Learning, SampleIntegrator, TileState, TileStats};
 pub use tile::{pixel_seed, tiles, PixelRect, Tile, TILE_SIZE};
 
 use crate::film::Film;
@@ -60,15 +63,39 @@ impl<S> RenderOutput<S> {
     }
 }
 
-/// What one tile's render produced.
-struct TileResult<S> {
+/// What one tile's render produced in one pass.
+struct TileResult<S, O> {
     rect: PixelRect,
-    /// Row-major, `rect`'s width per row.
+    /// Row-major, `rect`'s width per row: the mean of the pass's samples.
     pixels: Vec<[f32; 3]>,
     /// Work per camera sample, per pixel.
     work: Vec<f32>,
     counts: RayCounts,
     stats: S,
+    observed: O,
+}
+
+/// One pass of a render.
+#[derive(Clone, Copy, Debug)]
+struct Pass {
+    /// Its index.
+    index: u64,
+    /// Its samples per pixel.
+    samples: u32,
+}
+
+impl Pass {
+    /// The seed of pixel (x, y)'s generator in this pass: the pixel's own in pass 0, mixed
+    /// with the pass index after it. (PCG streams of one seed are correlated, so passes
+    /// take new seeds rather than new streams.)
+    fn pixel_seed(self, seed: u64, x: usize, y: usize, width: usize) -> u64 {
+        let own = pixel_seed(seed, x, y, width);
+        if self.index == 0 {
+            own
+        } else {
+            ais::rng::mix64(own ^ self.index.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        }
+    }
 }
 
 fn progress_bar(tiles: usize, visible: bool) -> ProgressBar {
@@ -94,60 +121,99 @@ pub fn render<I: SampleIntegrator>(
 ) -> RenderOutput<<I::Tile as TileState>::Stats> {
     let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
     let rects = tiles(width, height);
-    let progress = progress_bar(rects.len(), settings.progress);
+    let passes = integrator.passes(settings.samples_per_pixel);
+    let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
-    let results: Vec<_> = rects
-        .par_iter()
-        .map(|&rect| {
-            let tile = Tile {
-                rect,
-                image: (width, height),
-                seed: settings.seed,
-            };
-            let result = render_tile(world, integrator, settings, &tile);
-            progress.inc(1);
-            result
-        })
-        .collect();
-    progress.finish_and_clear();
-    let mut film = Film::new(width, height);
-    let mut rays = RayCounts::default();
-    let mut stats = <<I::Tile as TileState>::Stats>::default();
-    let mut work_per_sample = vec![0.0; width * height];
-    for result in results {
-        rays.merge(result.counts);
-        stats.merge(result.stats);
-        let rect = result.rect;
-        for (i, (value, work)) in result.pixels.into_iter().zip(result.work).enumerate() {
-            let (x, y) = (rect.x0 + i % rect.width(), rect.y0 + i / rect.width());
-            film.add(x, y, value);
-            work_per_sample[y * width + x] = work;
+    let mut learned = I::Learned::default();
+    let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(width, height);
+    for (index, &samples) in passes.iter().enumerate() {
+        let pass = Pass {
+            index: index as u64,
+            samples,
+        };
+        let results: Vec<_> = rects
+            .par_iter()
+            .map(|&rect| {
+                let tile = Tile {
+                    rect,
+                    image: (width, height),
+                    seed: settings.seed,
+                };
+                let result = render_tile(world, integrator, &learned, pass, &tile);
+                progress.inc(1);
+                result
+            })
+            .collect();
+        for result in results {
+            learned.merge(output.add(result, samples, settings.samples_per_pixel));
         }
     }
+    progress.finish_and_clear();
     RenderOutput {
-        image: film.image(),
-        rays,
-        stats,
-        work_per_sample,
+        image: output.film.image(),
+        rays: output.rays,
+        stats: output.stats,
+        work_per_sample: output.work_per_sample,
         time: started.elapsed(),
     }
 }
 
-/// Renders one tile with a fresh integrator state.
+/// The passes' results so far.
+struct Accumulated<S> {
+    film: Film,
+    rays: RayCounts,
+    stats: S,
+    work_per_sample: Vec<f32>,
+    width: usize,
+}
+
+impl<S: TileStats> Accumulated<S> {
+    fn new(width: usize, height: usize) -> Self {
+        Accumulated {
+            film: Film::new(width, height),
+            rays: RayCounts::default(),
+            stats: S::default(),
+            work_per_sample: vec![0.0; width * height],
+            width,
+        }
+    }
+
+    /// Adds a tile's pass of `samples` of `spp` samples per pixel; returns its observations.
+    fn add<O>(&mut self, result: TileResult<S, O>, samples: u32, spp: u32) -> O {
+        self.rays.merge(result.counts);
+        self.stats.merge(result.stats);
+        let rect = result.rect;
+        let share = samples as f32 / spp.max(1) as f32;
+        for (i, (value, work)) in result.pixels.into_iter().zip(result.work).enumerate() {
+            let (x, y) = (rect.x0 + i % rect.width(), rect.y0 + i / rect.width());
+            self.film.add_weighted(x, y, value, samples as f64);
+            let slot = &mut self.work_per_sample[y * self.width + x];
+            *slot = if samples == spp {
+                work
+            } else {
+                *slot + work * share
+            };
+        }
+        result.observed
+    }
+}
+
+/// Renders one pass of one tile with a fresh integrator state.
 fn render_tile<I: SampleIntegrator>(
     world: &World,
     integrator: &I,
-    settings: &RenderSettings,
+    learned: &I::Learned,
+    pass: Pass,
     tile: &Tile,
-) -> TileResult<<I::Tile as TileState>::Stats> {
+) -> TileResult<<I::Tile as TileState>::Stats, <I::Tile as TileState>::Observed> {
     let mut counts = RayCounts::default();
-    let mut state = integrator.begin_tile(world, tile, &mut counts);
+    let mut state = integrator.begin_tile(world, tile, learned, &mut counts);
     let (width, height) = tile.image;
-    let spp = settings.samples_per_pixel;
+    let spp = pass.samples;
     let mut pixels = Vec::with_capacity(tile.rect.area());
     let mut work = Vec::with_capacity(tile.rect.area());
     for (x, y) in tile.rect.pixels() {
-        let mut rng = Pcg32::new(pixel_seed(settings.seed, x, y, width), 0);
+        let mut rng = Pcg32::new(pass.pixel_seed(tile.seed, x, y, width), 0);
         let work_before = state.work();
         let mut sum = [0.0f64; 3];
         for _ in 0..spp {
@@ -162,11 +228,13 @@ fn render_tile<I: SampleIntegrator>(
         pixels.push(sum.map(|s| (s / spp as f64) as f32));
         work.push((state.work() - work_before) as f32 / spp as f32);
     }
+    let observed = state.take_observed();
     TileResult {
         rect: tile.rect,
         pixels,
         work,
         counts,
         stats: state.finish(),
+        observed,
     }
 }

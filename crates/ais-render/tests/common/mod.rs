@@ -60,7 +60,11 @@ pub fn npm_package(test: &str, spec: &str) -> Option<PathBuf> {
 /// `scenes/make_assets.py`) if they are missing; `Err` says why they could not be.
 pub fn shipped_scenes() -> Result<PathBuf, String> {
     let folder = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    if !folder.join("assets/sky.hdr").exists() || !folder.join("assets/blob.obj").exists() {
+    let assets = ["sky.hdr", "blob.obj", "leaves.obj", "ball.obj"];
+    if assets
+        .iter()
+        .any(|name| !folder.join("assets").join(name).exists())
+    {
         let made = Command::new("python3")
             .arg(folder.join("make_assets.py"))
             .status();

@@ -64,8 +64,15 @@ pub fn snapshots(
         sampler: &CandidateSampler::plain(settings.strategy),
         seed,
         start: ais::MapStart::Empty,
+        field: None,
     };
-    run_batch(&run, &mut batch, &mut RayCounts::default(), &mut snapshots);
+    run_batch(
+        &run,
+        &mut batch,
+        &mut RayCounts::default(),
+        &mut snapshots,
+        None,
+    );
     Some(snapshots.taken)
 }
 

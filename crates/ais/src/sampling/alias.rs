@@ -174,8 +174,15 @@ mod tests {
             let table = AliasTable::new(&weights);
             let sum: f64 = weights.iter().sum();
             for (i, p) in realised(&table).into_iter().enumerate() {
-                let expected = if sum > 0.0 { weights[i] / sum } else { 1.0 / size as f64 };
-                assert!((p - expected).abs() < 1e-6, "bin {i} of {size}: {p} vs {expected}");
+                let expected = if sum > 0.0 {
+                    weights[i] / sum
+                } else {
+                    1.0 / size as f64
+                };
+                assert!(
+                    (p - expected).abs() < 1e-6,
+                    "bin {i} of {size}: {p} vs {expected}"
+                );
                 assert!((table.probability(i) as f64 - expected).abs() < 1e-6);
             }
         }

@@ -9,6 +9,7 @@ use super::strategy::GatherPoint;
 use crate::lights::luminance;
 use crate::render::RayCounts;
 use crate::world::World;
+use ais::field::{CellRecorder, FieldCell};
 use ais::{rating, Batch, BatchConfig, Decision, MapStart};
 use glam::Vec3;
 
@@ -42,6 +43,8 @@ pub struct BatchRun<'a> {
     pub seed: u64,
     /// Whether the batch keeps the map it holds or starts from an empty one.
     pub start: MapStart,
+    /// The learned field's cell, when it gives the acceptance (`map = field`).
+    pub field: Option<FieldCell<'a>>,
 }
 
 /// The running mean of earlier candidates' unoccluded values (value-aware acceptance).
@@ -63,11 +66,13 @@ impl RunningMean {
 
 /// Runs one batch of `run.settings.rays` rays through `batch` (configured for those
 /// settings, or a variant of them) and returns its estimate of the reflected direct light.
+/// Every traced ray that could bring light is recorded in `recorder`, when given.
 pub fn run_batch<P: BatchProbe>(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
     counts: &mut RayCounts,
     probe: &mut P,
+    mut recorder: Option<&mut CellRecorder>,
 ) -> Vec3 {
     let at = run.at;
     probe.started();
@@ -84,8 +89,11 @@ pub fn run_batch<P: BatchProbe>(
         let (decision, known) = decide(run, batch, &mut values, direction, in_support);
         if let Decision::Trace { .. } = decision {
             let (value, rating) = trace(run, direction, known, counts);
-            batch.record(value.to_array(), rating);
-            probe.recorded(batch, value.to_array(), rating);
+            if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), rating.free()) {
+                recorder.record(direction.into(), free);
+            }
+            batch.record(value.to_array(), rating.rating);
+            probe.recorded(batch, value.to_array(), rating.rating);
         }
     }
     let estimate = batch.finish();
@@ -111,21 +119,21 @@ fn decide(
     direction: Vec3,
     in_support: bool,
 ) -> (Decision, Option<Known>) {
-    let (at, acceptance) = (run.at, run.settings.acceptance);
+    let acceptance = run.settings.acceptance;
+    if let Some(cell) = &run.field {
+        // Visibility alone: computing each candidate's value before deciding (to always
+        // trace the bright ones) cost more time than it saved, measured on the rooms.
+        let decision =
+            batch.decide_with(direction, in_support, |_| cell.acceptance(direction.into()));
+        return (decision, None);
+    }
     if acceptance.needs_value() && in_support {
-        let density = run.sampler.pdf(at, direction);
-        let leaving = Leaving::new(run.world, at, direction);
-        let value = if density > 0.0 {
-            luminance(at.material.eval(&at.frame, at.wo, direction) * leaving.unoccluded)
-                / density as f32
-        } else {
-            0.0
-        };
+        let (value, known) = unoccluded_value(run, direction);
         let mean = values.mean_then_add(value);
         let decision = batch.decide_with(direction, in_support, |affinity| {
             acceptance.probability(affinity, value, mean)
         });
-        return (decision, Some(Known { density, leaving }));
+        return (decision, Some(known));
     }
     let decision = if run.settings.map_use == MapUse::Proposal {
         // The map is already in the proposal: trace every candidate.
@@ -138,13 +146,43 @@ fn decide(
     (decision, None)
 }
 
-/// Traces an accepted candidate: its contribution f·L/p and its rating.
+/// The candidate's unoccluded value (luminance of f·L/p with nothing in the way), and what
+/// tracing it will need.
+fn unoccluded_value(run: &BatchRun, direction: Vec3) -> (f32, Known) {
+    let at = run.at;
+    let density = run.sampler.pdf(at, direction);
+    let leaving = Leaving::new(run.world, at, direction);
+    let value = if density > 0.0 {
+        luminance(at.material.eval(&at.frame, at.wo, direction) * leaving.unoccluded)
+            / density as f32
+    } else {
+        0.0
+    };
+    (value, Known { density, leaving })
+}
+
+/// What a traced candidate saw, for the batch and the field.
+struct Seen {
+    /// Actual over unoccluded radiance, in [0, 1].
+    rating: f32,
+    /// Whether a ray was traced toward light (a candidate bringing nothing is not traced).
+    traced: bool,
+}
+
+impl Seen {
+    /// Whether the ray was free, if one was traced.
+    fn free(&self) -> Option<bool> {
+        self.traced.then_some(self.rating > 0.0)
+    }
+}
+
+/// Traces an accepted candidate: its contribution f·L/p and what it saw.
 fn trace(
     run: &BatchRun,
     direction: Vec3,
     known: Option<Known>,
     counts: &mut RayCounts,
-) -> (Vec3, f32) {
+) -> (Vec3, Seen) {
     let at = run.at;
     let Known {
         density: pdf,
@@ -155,12 +193,18 @@ fn trace(
     });
     // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 {
-        return (Vec3::ZERO, rating(0.0, 0.0));
+        let nothing = Seen {
+            rating: rating(0.0, 0.0),
+            traced: false,
+        };
+        return (Vec3::ZERO, nothing);
     }
+    let traced = leaving.unoccluded != Vec3::ZERO;
     let actual = leaving.trace(run.world, counts);
     let value = at.material.eval(&at.frame, at.wo, direction) * actual / pdf as f32;
-    (
-        value,
-        rating(luminance(actual), luminance(leaving.unoccluded)),
-    )
+    let seen = Seen {
+        rating: rating(luminance(actual), luminance(leaving.unoccluded)),
+        traced,
+    };
+    (value, seen)
 }

@@ -141,8 +141,9 @@ impl LearningPass {
             sampler: &CandidateSampler::plain(learning.strategy),
             seed: ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64,
             start: MapStart::Empty,
+            field: None,
         };
-        run_batch(&run, batch, counts, &mut ());
+        run_batch(&run, batch, counts, &mut (), None);
         let observations = batch
             .observations()
             .expect("learning gathers observe their rays");

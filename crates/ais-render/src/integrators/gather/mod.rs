@@ -24,18 +24,69 @@ pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing
 pub use strategy::{gather_point, GatherPoint, Strategy};
 
 use crate::geometry::Ray;
-use crate::render::{RayCounts, Tile, TileState, TileStats};
+use crate::render::{Learning, RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
+use ais::field::{CellKey, FieldObservations, VisibilityField};
 use ais::rng::Pcg32;
 use ais::shared::{blend_neighbours, NeighbourSource, RecentGathers};
 use ais::{AffinityMap, Batch, MapStart};
 use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
+use std::sync::Arc;
 
 /// The radius of a gather's neighbourhood among the tile's recent gathers, in pixel
 /// footprints at the gather point.
 pub const RADIUS_PIXELS: f32 = 3.0;
+
+/// The side of the visibility field's cells, in pixel footprints at the gather point.
+pub const FIELD_CELL_PIXELS: f32 = 4.0;
+
+/// Texels per side of a field cell's octahedral map (64 texels of 0.2 sr each).
+pub const FIELD_SIDE: u32 = ais::field::DEFAULT_SIDE;
+
+/// What the gather learns between passes: the visibility field (`map = field`).
+#[derive(Clone, Debug)]
+pub struct GatherLearning {
+    /// The field, shared read-only by the tiles of a pass.
+    pub field: Arc<VisibilityField>,
+}
+
+impl Default for GatherLearning {
+    fn default() -> Self {
+        GatherLearning {
+            field: Arc::new(VisibilityField::new(FIELD_SIDE)),
+        }
+    }
+}
+
+impl Learning for GatherLearning {
+    type Observed = Option<FieldObservations>;
+
+    fn merge(&mut self, observed: Option<FieldObservations>) {
+        if let Some(observed) = observed {
+            // The pass's tiles have dropped their handles: no copy is made.
+            Arc::make_mut(&mut self.field).merge(&observed);
+        }
+    }
+}
+
+/// Samples per pixel of each pass of a render with `map = field`: 1, 1, 2, 4, … doubling,
+/// the last taking what is left, so the field learns early and is used for most samples.
+pub fn field_passes(spp: u32) -> Vec<u32> {
+    let mut passes = Vec::new();
+    let (mut done, mut next) = (0u32, 1u32);
+    while done < spp {
+        let samples = if passes.len() < 2 { 1 } else { next };
+        let samples = samples.min(spp - done);
+        passes.push(samples);
+        done += samples;
+        if passes.len() >= 2 {
+            next = next.saturating_mul(2);
+        }
+    }
+    passes
+}
 
 /// What a render's gathers report: the batches' counters and the AIS memory a thread held.
 #[derive(Clone, Copy, Debug, Default)]
@@ -45,12 +96,20 @@ pub struct GatherStats {
     /// The most AIS state (maps, shared maps, guides) any one tile held, in bytes: what a
     /// thread needs on top of the scene.
     pub memory_per_thread: usize,
+    /// The visibility field at the end of the render, in bytes (`map = field`).
+    pub field_memory: usize,
+    /// Gathers that used the field for roulette, and gathers where it stood aside.
+    pub field_gathers: [u64; 2],
 }
 
 impl TileStats for GatherStats {
     fn merge(&mut self, other: GatherStats) {
         self.ais.merge(&other.ais);
         self.memory_per_thread = self.memory_per_thread.max(other.memory_per_thread);
+        self.field_memory = self.field_memory.max(other.field_memory);
+        for (mine, theirs) in self.field_gathers.iter_mut().zip(other.field_gathers) {
+            *mine += theirs;
+        }
     }
 }
 
@@ -66,6 +125,12 @@ pub struct GatherTile<P: BatchProbe = ()> {
     learned: LearningPass,
     /// The guide distributions of `map_use = proposal` (allocated on first use).
     guide: Option<Guide>,
+    /// The visibility field learned in earlier passes (`map = field`).
+    field: Arc<VisibilityField>,
+    /// The rays this tile traced in this pass, for the field (`map = field`).
+    observations: Option<FieldObservations>,
+    /// Gathers that used the field, and gathers where it stood aside.
+    field_gathers: [u64; 2],
     /// What watches the batches.
     pub probe: P,
 }
@@ -77,14 +142,19 @@ impl<P: BatchProbe> GatherTile<P> {
         world: &World,
         settings: &GatherSettings,
         tile: &Tile,
+        learning: &GatherLearning,
         counts: &mut RayCounts,
         probe: P,
     ) -> Self {
+        let field = settings.map == MapSource::Field;
         let mut state = GatherTile {
             batch: None,
             recent: RecentGathers::default(),
             learned: LearningPass::default(),
             guide: None,
+            field: learning.field.clone(),
+            observations: field.then(|| FieldObservations::new(FIELD_SIDE)),
+            field_gathers: [0; 2],
             probe,
         };
         if let (true, Sharing::LearningPass { stride }) = (settings.shares_maps(), settings.sharing)
@@ -103,6 +173,10 @@ impl<P: BatchProbe> GatherTile<P> {
             + self.recent.memory_bytes()
             + self.learned.memory_bytes()
             + self.guide.as_ref().map_or(0, Guide::memory_bytes)
+            + self
+                .observations
+                .as_ref()
+                .map_or(0, FieldObservations::memory_bytes)
     }
 
     /// The batches' counters so far.
@@ -119,10 +193,22 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
         self.batch.as_ref().map_or(0, |b| b.stats().traced)
     }
 
+    type Observed = Option<FieldObservations>;
+
+    fn take_observed(&mut self) -> Option<FieldObservations> {
+        self.observations.take()
+    }
+
     fn finish(self) -> GatherStats {
         GatherStats {
             ais: self.ais_stats(),
             memory_per_thread: self.memory_bytes(),
+            field_memory: if self.field.cell_count() > 0 {
+                self.field.memory_bytes()
+            } else {
+                0
+            },
+            field_gathers: self.field_gathers,
         }
     }
 }
@@ -215,9 +301,22 @@ pub fn gather<P: BatchProbe>(
         return emitted;
     }
     let mut at = gather_point(world, &hit, -ray.direction);
+    let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
+    let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
+    if settings.map == MapSource::Field {
+        let site = FieldSite {
+            key: CellKey::new(
+                hit.point.into(),
+                hit.geometric_normal.into(),
+                CellKey::level_for(FIELD_CELL_PIXELS * footprint),
+            ),
+            at: &at,
+            seed,
+        };
+        return emitted + field_gather(world, settings, &site, state, counts);
+    }
     let sharing = settings.shares_maps();
     let batch = batch_for(&mut state.batch, settings);
-    let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     let mut sampler = CandidateSampler::plain(settings.strategy);
     let start = if sharing {
         let map = batch.map_mut().expect("shared maps have a map");
@@ -225,7 +324,7 @@ pub fn gather<P: BatchProbe>(
             recent: &state.recent,
             learned: &state.learned,
             sharing: settings.sharing,
-            footprint: hit.t * world.camera.pixel_angle(world.resolution.0),
+            footprint,
         };
         let found = neighbourhood.blend_into(map, hit.point, at.frame.normal);
         if settings.map_use == MapUse::Proposal && found > 0 {
@@ -245,8 +344,9 @@ pub fn gather<P: BatchProbe>(
         sampler: &sampler,
         seed,
         start,
+        field: None,
     };
-    let value = run_batch(&run, batch, counts, &mut state.probe);
+    let value = run_batch(&run, batch, counts, &mut state.probe, None);
     if sharing {
         let observations = batch
             .observations()
@@ -256,4 +356,45 @@ pub fn gather<P: BatchProbe>(
             .remember(hit.point, at.frame.normal, observations);
     }
     emitted + value
+}
+
+/// Where a `map = field` gather happens.
+struct FieldSite<'a> {
+    /// Its cell of the field.
+    key: CellKey,
+    /// The gather point.
+    at: &'a GatherPoint<'a>,
+    /// The batch's scrambling seed.
+    seed: u64,
+}
+
+/// A gather with acceptance from the learned field: roulette where the field's cell says it
+/// pays, every candidate traced (and no map work) elsewhere. Its traced rays are recorded
+/// for the next pass's field.
+fn field_gather<P: BatchProbe>(
+    world: &World,
+    settings: &GatherSettings,
+    site: &FieldSite,
+    state: &mut GatherTile<P>,
+    counts: &mut RayCounts,
+) -> Vec3 {
+    let field = state.field.clone();
+    let cell = field.cell(&site.key).filter(|cell| cell.worth_rolling());
+    state.field_gathers[usize::from(cell.is_none())] += 1;
+    let sampler = CandidateSampler::plain(settings.strategy);
+    let run = BatchRun {
+        world,
+        settings,
+        at: site.at,
+        sampler: &sampler,
+        seed: site.seed,
+        start: MapStart::Empty,
+        field: cell,
+    };
+    let batch = batch_for(&mut state.batch, settings);
+    let mut recorder = state
+        .observations
+        .as_mut()
+        .map(|observations| observations.cell_mut(site.key));
+    run_batch(&run, batch, counts, &mut state.probe, recorder.as_mut())
 }

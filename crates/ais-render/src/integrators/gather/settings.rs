@@ -7,8 +7,8 @@
 //! | `rays` | integer | 16 | candidates per gather, n (1 to 1,048,576) |
 //! | `budget` | string | `candidates` | what `rays` counts: `candidates` (AIS traces only the accepted ones) or `traced` (AIS draws extra candidates to trace about n) |
 //! | `placement` | string | `halton` | candidate placement: `halton` (scrambled per batch) or `random` |
-//! | `ais` | string | `off` | a preset of the three map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided` |
-//! | `map` | string | `none` | where a batch's affinity map starts: `none` (AIS off), `batch` (empty, learned from the batch's own rays: the talk's), `neighbours` (blended from neighbouring gathers, see `sharing`) |
+//! | `ais` | string | `off` | a preset of the three map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided`, `auto` |
+//! | `map` | string | `none` | where a batch's affinity map starts: `none` (AIS off), `batch` (empty, learned from the batch's own rays: the talk's), `neighbours` (blended from neighbouring gathers, see `sharing`), `field` (the visibility field learned in earlier passes over the whole image) |
 //! | `update` | string | `off` | how the batch learns from its own rays, in frozen-map epochs: `off`, `aggressive`, `conservative` (the talk's shadow-edge resets) |
 //! | `map_use` | string | `roulette` | how the map is used: `roulette` (skip probably blocked candidates, weight 1/a) or `proposal` (fold the map into the proposal, reject nothing) |
 //! | `acceptance` | string | `affinity` | roulette's acceptance: `affinity` (the talk's), `sqrt`, `value`, `efficient` |
@@ -19,7 +19,7 @@
 //!
 //! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
 //! `update`; `shared` = `map neighbours`; `warm` = `map neighbours, update aggressive`;
-//! `guided` = `map neighbours, map_use proposal`. A preset sets `map`, `update` and
+//! `guided` = `map neighbours, map_use proposal`; `auto` = `map field`. A preset sets `map`, `update` and
 //! `map_use`; the other parameters keep their values, and any given alongside it apply after
 //! it.
 
@@ -61,6 +61,10 @@ pub enum MapSource {
     /// Blended from the rays of neighbouring gathers (see [`Sharing`]) and held fixed, so the
     /// batch is exactly unbiased.
     Neighbours,
+    /// No map of its own: the acceptance comes from the visibility field learned over the
+    /// whole image in earlier passes ([`ais::field`]), fixed during a pass. Where the field
+    /// predicts no gain, the gather traces every candidate and does no map work.
+    Field,
 }
 
 /// How a batch learns from its own rays.
@@ -99,17 +103,20 @@ pub enum Preset {
     Warm,
     /// That map folded into the proposal.
     Guided,
+    /// The learned visibility field, standing aside where it predicts no gain.
+    Auto,
 }
 
 impl Preset {
     /// Every preset.
-    pub const ALL: [Preset; 6] = [
+    pub const ALL: [Preset; 7] = [
         Preset::Off,
         Preset::Aggressive,
         Preset::Conservative,
         Preset::Shared,
         Preset::Warm,
         Preset::Guided,
+        Preset::Auto,
     ];
 
     /// Its name.
@@ -131,6 +138,7 @@ impl Preset {
             Preset::Shared => (S::Neighbours, Update::Off, MapUse::Roulette),
             Preset::Warm => (S::Neighbours, Update::Aggressive, MapUse::Roulette),
             Preset::Guided => (S::Neighbours, Update::Off, MapUse::Proposal),
+            Preset::Auto => (S::Field, Update::Off, MapUse::Roulette),
         }
     }
 }
@@ -289,6 +297,7 @@ impl Choice for MapSource {
         ("none", MapSource::None),
         ("batch", MapSource::Batch),
         ("neighbours", MapSource::Neighbours),
+        ("field", MapSource::Field),
     ];
 }
 
@@ -318,6 +327,7 @@ impl Choice for Preset {
         ("shared", Preset::Shared),
         ("warm", Preset::Warm),
         ("guided", Preset::Guided),
+        ("auto", Preset::Auto),
     ];
 }
 
@@ -459,6 +469,14 @@ impl GatherSettings {
             (MapSource::None, _, _) => {
                 Err("map none (AIS off) takes neither an update nor map_use proposal".into())
             }
+            (MapSource::Field, Update::Off, MapUse::Roulette)
+                if self.acceptance == Acceptance::Affinity =>
+            {
+                Ok(())
+            }
+            (MapSource::Field, _, _) => Err(
+                "map field (auto) chooses its own acceptance and takes no update or map_use".into(),
+            ),
             (MapSource::Batch, Update::Off, _) => {
                 Err("a per-batch map (map batch) needs an update rule to learn with".into())
             }
@@ -516,7 +534,8 @@ impl GatherSettings {
             placement: self.placement,
             ..BatchConfig::default()
         };
-        if self.map == MapSource::None {
+        if matches!(self.map, MapSource::None | MapSource::Field) {
+            // The field's acceptance comes from the host (the gather), not from a batch map.
             return BatchConfig {
                 affinity: None,
                 learning: ais::Learning::Off,

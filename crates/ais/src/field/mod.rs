@@ -1,0 +1,443 @@
+//! A learned directional visibility field over the whole image: for a region of space and a
+//! range of normals (a *cell*), how often the rays traced from there toward each direction
+//! were free.
+//!
+//! The state is split as Open PGL splits its Field and SamplingDistribution:
+//! - [`VisibilityField`] is the learned state. It is read-only while a pass renders, so every
+//!   acceptance probability derived from it is fixed before the candidate is drawn, Russian
+//!   roulette with weight 1/a stays exactly unbiased, and the image does not depend on the
+//!   number of threads.
+//! - [`FieldObservations`] is per-thread scratch: the rays a tile traced, counted per cell
+//!   and texel. Between passes the host merges every tile's observations into the field.
+//!   Counts are integers, so the merged field is the same in whatever order tiles finish.
+//!
+//! Cells are keyed by position on a hashed grid whose spacing the host chooses per lookup,
+//! as a power of two (so that it can follow the pixel footprint: a cell covers a few pixels
+//! wherever it is), and by the dominant axis of the normal. Each cell holds an equal-area
+//! octahedral map of `side × side` texels ([`octahedral`]). A lookup is one hash probe per
+//! gather and one texel index per candidate: O(1) whatever the scene.
+
+pub mod octahedral;
+
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// What a texel of a cell has seen: rays traced and, of those, rays that were free.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct TexelCounts {
+    /// Traced rays that reached the light (or the sky).
+    pub free: u32,
+    /// Traced rays.
+    pub traced: u32,
+}
+
+impl TexelCounts {
+    fn add(&mut self, other: TexelCounts) {
+        self.free = self.free.saturating_add(other.free);
+        self.traced = self.traced.saturating_add(other.traced);
+    }
+}
+
+/// The key of a cell: grid level (log2 of its spacing), integer coordinates at that level,
+/// and the dominant axis of the normal (0..6: ±x, ±y, ±z).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct CellKey {
+    level: i8,
+    face: u8,
+    coordinates: [i32; 3],
+}
+
+impl CellKey {
+    /// The cell holding `position` (normal `normal`) on the grid of spacing `2^level`.
+    /// Coordinates beyond ±2³¹ cells clamp; a non-finite position lands in one cell.
+    pub fn new(position: [f32; 3], normal: [f32; 3], level: i8) -> Self {
+        let scale = (-(level as f32)).exp2();
+        let coordinates = position.map(|p| {
+            let c = (p * scale).floor();
+            if c.is_finite() {
+                c.clamp(i32::MIN as f32, i32::MAX as f32) as i32
+            } else {
+                0
+            }
+        });
+        CellKey {
+            level,
+            face: dominant_face(normal),
+            coordinates,
+        }
+    }
+
+    /// The grid level whose spacing is the power of two nearest to `spacing` (world units).
+    pub fn level_for(spacing: f32) -> i8 {
+        if spacing.is_finite() && spacing > 0.0 {
+            spacing.log2().round().clamp(-60.0, 60.0) as i8
+        } else {
+            0
+        }
+    }
+}
+
+/// 0..6 for the normal's dominant axis and its sign.
+fn dominant_face(normal: [f32; 3]) -> u8 {
+    let [x, y, z] = normal;
+    let (ax, ay, az) = (x.abs(), y.abs(), z.abs());
+    let (axis, value) = if ax >= ay && ax >= az {
+        (0, x)
+    } else if ay >= az {
+        (1, y)
+    } else {
+        (2, z)
+    };
+    axis * 2 + u8::from(value < 0.0)
+}
+
+/// A fast multiplicative hasher for cell keys (the keys are not adversarial: they come from
+/// the host's own hit points).
+#[derive(Default)]
+pub struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(b as u64);
+        }
+    }
+
+    fn write_u8(&mut self, value: u8) {
+        self.write_u64(value as u64);
+    }
+
+    fn write_i8(&mut self, value: i8) {
+        self.write_u64(value as u8 as u64);
+    }
+
+    fn write_i32(&mut self, value: i32) {
+        self.write_u64(value as u32 as u64);
+    }
+
+    fn write_u64(&mut self, value: u64) {
+        self.0 = (self.0.rotate_left(5) ^ value).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+}
+
+type KeyMap<V> = HashMap<CellKey, V, BuildHasherDefault<KeyHasher>>;
+
+/// The learned field: every cell seen so far and its texels' counts.
+#[derive(Clone, Debug)]
+pub struct VisibilityField {
+    side: u32,
+    /// Cell → index of its first texel in `counts`.
+    cells: KeyMap<u32>,
+    counts: Vec<TexelCounts>,
+    /// Per cell, the sum of its texels' counts.
+    totals: Vec<TexelCounts>,
+}
+
+/// Texels per side of a cell's map by default: 64 texels of 0.2 sr each.
+pub const DEFAULT_SIDE: u32 = 8;
+
+impl Default for VisibilityField {
+    fn default() -> Self {
+        VisibilityField::new(DEFAULT_SIDE)
+    }
+}
+
+impl VisibilityField {
+    /// An empty field whose cells hold `side × side` texels (`side` in 1..=64).
+    pub fn new(side: u32) -> Self {
+        VisibilityField {
+            side: side.clamp(1, 64),
+            cells: KeyMap::default(),
+            counts: Vec::new(),
+            totals: Vec::new(),
+        }
+    }
+
+    /// Texels per side of a cell's map.
+    pub fn side(&self) -> u32 {
+        self.side
+    }
+
+    /// Number of cells learned.
+    pub fn cell_count(&self) -> usize {
+        self.totals.len()
+    }
+
+    /// Bytes held by the field.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.cells.capacity() * (std::mem::size_of::<(CellKey, u32)>() + 1)
+            + (self.counts.capacity() + self.totals.capacity()) * std::mem::size_of::<TexelCounts>()
+    }
+
+    /// The cell `key`, if any ray was ever recorded there.
+    #[inline]
+    pub fn cell(&self, key: &CellKey) -> Option<FieldCell<'_>> {
+        let &first = self.cells.get(key)?;
+        let texels = (self.side * self.side) as usize;
+        let index = first as usize / texels;
+        Some(FieldCell {
+            counts: &self.counts[first as usize..first as usize + texels],
+            total: self.totals[index],
+            side: self.side,
+        })
+    }
+
+    /// Adds what a tile observed (observations made with another `side` are refused).
+    pub fn merge(&mut self, observations: &FieldObservations) {
+        assert_eq!(
+            observations.side, self.side,
+            "observations of another map size"
+        );
+        let texels = (self.side * self.side) as usize;
+        for (key, seen) in &observations.cells {
+            let next = self.counts.len() as u32;
+            let first = *self.cells.entry(*key).or_insert_with(|| next) as usize;
+            if first == next as usize {
+                self.counts.resize(first + texels, TexelCounts::default());
+                self.totals.push(TexelCounts::default());
+            }
+            let index = first / texels;
+            for (texel, &count) in seen.iter().enumerate() {
+                self.counts[first + texel].add(count);
+                self.totals[index].add(count);
+            }
+        }
+    }
+}
+
+/// Pseudo-observations of a free ray added to every texel: a texel seen a few times keeps
+/// an acceptance near 1, and only evidence pulls it down.
+pub const PRIOR_FREE: f32 = 2.0;
+
+/// The lowest acceptance the field gives: a free ray in a texel the field calls blocked
+/// weighs at most 1 / this.
+pub const LOWEST_ACCEPTANCE: f32 = 0.1;
+
+/// A cell whose rays were free more often than this gains too little from roulette to pay
+/// for its lookups: its gathers trace every candidate and do no map work.
+pub const STAND_ASIDE_ABOVE: f32 = 0.6;
+
+/// A cell with fewer traced rays than this is not trusted yet: its gathers trace every
+/// candidate.
+pub const LEAST_EVIDENCE: u32 = 32;
+
+/// The acceptance probability for a candidate toward a texel with these counts: the square
+/// root (the cost-optimal shape when a rejected candidate costs about what a traced one
+/// costs, see the repository's docs/technique.md) of the texel's visibility with
+/// [`PRIOR_FREE`] free pseudo-observations, floored at [`LOWEST_ACCEPTANCE`].
+#[inline]
+pub fn acceptance(texel: TexelCounts) -> f32 {
+    let visibility = (texel.free as f32 + PRIOR_FREE) / (texel.traced as f32 + PRIOR_FREE);
+    visibility.sqrt().clamp(LOWEST_ACCEPTANCE, 1.0)
+}
+
+/// One cell of the field, for the lookups of one gather.
+#[derive(Clone, Copy, Debug)]
+pub struct FieldCell<'a> {
+    counts: &'a [TexelCounts],
+    total: TexelCounts,
+    side: u32,
+}
+
+impl FieldCell<'_> {
+    /// The counts of the texel toward `direction` (world space, unit).
+    #[inline]
+    pub fn texel(&self, direction: [f32; 3]) -> TexelCounts {
+        self.counts[octahedral::texel_of(direction, self.side)]
+    }
+
+    /// The sum over the cell's texels.
+    pub fn total(&self) -> TexelCounts {
+        self.total
+    }
+
+    /// Whether roulette can pay here: the cell has [`LEAST_EVIDENCE`] rays and at most
+    /// [`STAND_ASIDE_ABOVE`] of them were free.
+    pub fn worth_rolling(&self) -> bool {
+        self.total.traced >= LEAST_EVIDENCE
+            && (self.total.free as f32) <= STAND_ASIDE_ABOVE * self.total.traced as f32
+    }
+
+    /// [`acceptance`] toward `direction`.
+    #[inline]
+    pub fn acceptance(&self, direction: [f32; 3]) -> f32 {
+        acceptance(self.texel(direction))
+    }
+}
+
+/// Per-thread scratch: the rays one tile traced in a pass, counted per cell and texel.
+#[derive(Clone, Debug)]
+pub struct FieldObservations {
+    side: u32,
+    cells: KeyMap<Box<[TexelCounts]>>,
+}
+
+impl FieldObservations {
+    /// Empty observations for cells of `side × side` texels (as [`VisibilityField::new`]).
+    pub fn new(side: u32) -> Self {
+        FieldObservations {
+            side: side.clamp(1, 64),
+            cells: KeyMap::default(),
+        }
+    }
+
+    /// Records one traced ray from cell `key` toward `direction`: free or blocked.
+    #[inline]
+    pub fn record(&mut self, key: CellKey, direction: [f32; 3], free: bool) {
+        self.cell_mut(key).record(direction, free);
+    }
+
+    /// The counts of cell `key`, to record a gather's rays with one hash probe.
+    pub fn cell_mut(&mut self, key: CellKey) -> CellRecorder<'_> {
+        let texels = (self.side * self.side) as usize;
+        let counts = self
+            .cells
+            .entry(key)
+            .or_insert_with(|| vec![TexelCounts::default(); texels].into_boxed_slice());
+        CellRecorder {
+            counts,
+            side: self.side,
+        }
+    }
+
+    /// Forgets everything recorded (keeping the allocation).
+    pub fn clear(&mut self) {
+        self.cells.clear();
+    }
+
+    /// Whether nothing was recorded.
+    pub fn is_empty(&self) -> bool {
+        self.cells.is_empty()
+    }
+
+    /// Bytes held.
+    pub fn memory_bytes(&self) -> usize {
+        let texels = (self.side * self.side) as usize;
+        std::mem::size_of::<Self>()
+            + self.cells.capacity() * std::mem::size_of::<(CellKey, Box<[TexelCounts]>)>()
+            + self.cells.len() * texels * std::mem::size_of::<TexelCounts>()
+    }
+}
+
+/// One cell's counts in [`FieldObservations`], for the rays of one gather.
+pub struct CellRecorder<'a> {
+    counts: &'a mut [TexelCounts],
+    side: u32,
+}
+
+impl CellRecorder<'_> {
+    /// Records one traced ray toward `direction`: free or blocked.
+    #[inline]
+    pub fn record(&mut self, direction: [f32; 3], free: bool) {
+        let texel = &mut self.counts[octahedral::texel_of(direction, self.side)];
+        texel.traced = texel.traced.saturating_add(1);
+        texel.free = texel.free.saturating_add(u32::from(free));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn merged_observations_are_found_by_cell_and_direction() {
+        let mut field = VisibilityField::new(4);
+        let key = CellKey::new([0.3, 0.1, -2.0], [0.0, 1.0, 0.0], -3);
+        let other = CellKey::new([0.3, 0.1, -2.0], [0.0, -1.0, 0.0], -3);
+        assert_ne!(key, other, "opposite normals are different cells");
+        let mut a = FieldObservations::new(4);
+        let mut b = FieldObservations::new(4);
+        for k in 0..10 {
+            a.record(key, [0.0, 1.0, 0.0], k < 7);
+            b.record(key, [0.0, 0.0, -1.0], false);
+        }
+        b.record(other, [1.0, 0.0, 0.0], true);
+        field.merge(&a);
+        field.merge(&b);
+        let cell = field.cell(&key).expect("learned");
+        assert_eq!(
+            cell.texel([0.0, 1.0, 0.0]),
+            TexelCounts {
+                free: 7,
+                traced: 10
+            }
+        );
+        assert_eq!(
+            cell.texel([0.0, 0.0, -1.0]),
+            TexelCounts {
+                free: 0,
+                traced: 10
+            }
+        );
+        assert_eq!(
+            cell.total(),
+            TexelCounts {
+                free: 7,
+                traced: 20
+            }
+        );
+        assert_eq!(field.cell(&other).unwrap().total().traced, 1);
+        assert!(field
+            .cell(&CellKey::new([5.0, 0.0, 0.0], [0.0, 1.0, 0.0], -3))
+            .is_none());
+        assert_eq!(field.cell_count(), 2);
+    }
+
+    #[test]
+    fn merging_in_any_order_gives_the_same_field() {
+        let keys: Vec<CellKey> = (0..50)
+            .map(|i| CellKey::new([i as f32 * 0.37, 0.0, 1.0], [1.0, 0.0, 0.0], 0))
+            .collect();
+        let tiles: Vec<FieldObservations> = (0..5)
+            .map(|t| {
+                let mut o = FieldObservations::new(8);
+                for (i, &key) in keys.iter().enumerate() {
+                    o.record(key, [0.6, 0.8, 0.0], (i + t) % 3 == 0);
+                }
+                o
+            })
+            .collect();
+        let mut forward = VisibilityField::new(8);
+        tiles.iter().for_each(|o| forward.merge(o));
+        let mut backward = VisibilityField::new(8);
+        tiles.iter().rev().for_each(|o| backward.merge(o));
+        for key in &keys {
+            let (f, b) = (forward.cell(key).unwrap(), backward.cell(key).unwrap());
+            assert_eq!(f.total(), b.total());
+            assert_eq!(f.texel([0.6, 0.8, 0.0]), b.texel([0.6, 0.8, 0.0]));
+        }
+    }
+
+    #[test]
+    fn acceptance_trusts_evidence_and_only_evidence() {
+        let seen = |free, traced| acceptance(TexelCounts { free, traced });
+        assert_eq!(seen(0, 0), 1.0);
+        assert!(seen(0, 3) > 0.6, "three blocked rays are not proof");
+        assert!((seen(0, 198) - 0.1).abs() < 1e-6, "the floor");
+        assert!(
+            (seen(23, 98) - 0.5).abs() < 1e-6,
+            "the square root of 25 / 100"
+        );
+        assert_eq!(seen(300, 300), 1.0);
+    }
+
+    #[test]
+    fn grid_levels_follow_the_spacing() {
+        assert_eq!(CellKey::level_for(1.0), 0);
+        assert_eq!(CellKey::level_for(0.1), -3);
+        assert_eq!(CellKey::level_for(3.0), 2);
+        assert_eq!(CellKey::level_for(f32::NAN), 0);
+        let a = CellKey::new([0.10, 0.0, 0.0], [0.0, 0.0, 1.0], -3);
+        let b = CellKey::new([0.12, 0.0, 0.0], [0.0, 0.0, 1.0], -3);
+        let c = CellKey::new([0.13, 0.0, 0.0], [0.0, 0.0, 1.0], -3);
+        assert_eq!(a, b);
+        assert_ne!(b, c);
+        let far = CellKey::new([f32::INFINITY, f32::NAN, 1e30], [0.0, 0.0, 1.0], -3);
+        assert_eq!(far.coordinates, [0, 0, i32::MAX]);
+    }
+}

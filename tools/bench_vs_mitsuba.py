@@ -1,0 +1,199 @@
+#!/usr/bin/env python3
+"""Render time of ais against Mitsuba 3 on the same scene files, side by side.
+
+    cargo build --release -p ais-cli
+    python3 tools/bench_vs_mitsuba.py --setup scenes/sunlit_room.xml [more scenes] \\
+        [--spp 64] [--rays 16] [--size 128x128] [--runs 3] [--markdown]
+
+Same work in both renderers: the scene's camera at `--size`, `--spp` camera samples per
+pixel, and per camera sample `--rays` gather rays. ais runs its gather with MIS and AIS off
+(half BSDF, half light samples on average); Mitsuba runs its `direct` integrator with
+`--rays`/2 emitter and `--rays`/2 BSDF samples. Every render is one process per scene, as
+Mitsuba's llvm variant has deadlocked on a second scene load here.
+
+Reported per scene, medians over `--runs`:
+- ais's render time at 2 threads (loading excluded: the "render time" line) and at 1 thread,
+  and the scaling between them;
+- Mitsuba 3's llvm_ad_rgb and scalar_rgb render times (`mi.render` after one warm-up
+  render, so the llvm variant's JIT compilation is excluded; loading excluded);
+- rays per second, counted by ais for ais; for Mitsuba, the same nominal count
+  (camera rays plus `--rays` per camera sample) over its time;
+- the ratio Mitsuba llvm time / ais time (above 1: ais is faster).
+
+Mitsuba's llvm variant needs an LLVM library of version 16 or later (Debian: the libllvm19
+package). It is found through DRJIT_LIBLLVM_PATH or in the usual library folders; without
+one, the llvm column is left out with a message. `--setup` makes `.venv` with Mitsuba and
+numpy, as tools/crosscheck.py does.
+"""
+import argparse
+import glob
+import json
+import os
+import re
+import statistics
+import subprocess
+import sys
+import tempfile
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import crosscheck  # noqa: E402  (the scene rewrite for Mitsuba and the venv set-up)
+
+ROOT = crosscheck.ROOT
+
+# Renders the scene `runs` times after a warm-up render and prints the times as JSON.
+MITSUBA_CHILD = r"""
+import json, sys, time
+import mitsuba as mi, drjit as dr
+mi.set_variant(sys.argv[2])
+scene = mi.load_file(sys.argv[1])
+spp, runs = int(sys.argv[3]), int(sys.argv[4])
+def timed(seed):
+    started = time.perf_counter()
+    image = mi.render(scene, seed=seed, spp=spp)
+    dr.eval(image)
+    dr.sync_thread()
+    return time.perf_counter() - started
+timed(0)
+print(json.dumps([timed(k + 1) for k in range(runs)]))
+"""
+
+
+def find_libllvm():
+    """An LLVM shared library that Dr.Jit can use (version 16 or later), or None."""
+    given = os.environ.get("DRJIT_LIBLLVM_PATH")
+    if given:
+        return given if os.path.exists(given) else None
+    candidates = glob.glob("/usr/lib/*/libLLVM-*.so") + glob.glob("/usr/lib/llvm-*/lib/libLLVM*.so")
+    versioned = []
+    for path in candidates:
+        match = re.search(r"LLVM-(\d+)", path) or re.search(r"llvm-(\d+)", path)
+        if match and int(match.group(1)) >= 16:
+            versioned.append((int(match.group(1)), path))
+    return max(versioned)[1] if versioned else None
+
+
+def mitsuba_times(scene, variant, args, libllvm):
+    """Median render time of Mitsuba's `variant` on `scene`, or None with a message."""
+    width, height = (int(v) for v in args.size.lower().split("x"))
+    with open(scene) as f:
+        text = crosscheck.mitsuba_scene_text(f.read(), width, height, args.rays // 2)
+    copy = os.path.join(os.path.dirname(os.path.abspath(scene)), f".bench-{os.getpid()}.xml")
+    with open(copy, "w") as f:
+        f.write(text)
+    env = dict(os.environ)
+    if libllvm:
+        env["DRJIT_LIBLLVM_PATH"] = libllvm
+    try:
+        done = subprocess.run([sys.executable, "-c", MITSUBA_CHILD, copy, variant, str(args.spp), str(args.runs)],
+                              capture_output=True, text=True, env=env, timeout=args.timeout)
+    except subprocess.TimeoutExpired:
+        return None, f"Mitsuba {variant} did not finish within {args.timeout} s"
+    finally:
+        os.remove(copy)
+    if done.returncode != 0:
+        return None, f"Mitsuba {variant} failed: {done.stderr.strip().splitlines()[-1:]}"
+    return statistics.median(json.loads(done.stdout.strip().splitlines()[-1])), None
+
+
+def ais_run(scene, threads, args):
+    """Median render time and counted rays of `ais render` on `scene` at `threads`."""
+    times, rays = [], 0
+    with tempfile.TemporaryDirectory() as work:
+        for k in range(args.runs):
+            command = [args.ais, "render", scene, "--resolution", args.size, "--spp", str(args.spp),
+                       "--integrator", "gather", "--strategy", "mis", "--rays", str(args.rays), "--ais", "off",
+                       "--threads", str(threads), "--seed", str(k), "--no-preview",
+                       "-o", os.path.join(work, "ais.exr")]
+            done = subprocess.run(command, capture_output=True, text=True)
+            if done.returncode != 0:
+                crosscheck.fail_setup(f"`{' '.join(command)}` failed:\n{done.stderr.strip()}")
+            report = done.stdout + done.stderr
+            times.append(float(re.search(r"render time\s+([0-9.]+) s", report).group(1)))
+            counted = re.search(r"rays\s+(\d+) camera \+ (\d+) occlusion", report)
+            rays = int(counted.group(1)) + int(counted.group(2))
+    return statistics.median(times), rays
+
+
+def measure(scene, args, libllvm):
+    """One row of the table."""
+    width, height = (int(v) for v in args.size.lower().split("x"))
+    nominal_rays = width * height * args.spp * (1 + args.rays)
+    ais2, rays = ais_run(scene, 2, args)
+    ais1, _ = ais_run(scene, 1, args)
+    row = {"scene": os.path.relpath(scene, ROOT), "ais_2": ais2, "ais_1": ais1, "ais_rays": rays,
+           "scaling": ais1 / ais2, "nominal_rays": nominal_rays}
+    for variant in ("llvm_ad_rgb", "scalar_rgb"):
+        if variant == "llvm_ad_rgb" and not libllvm:
+            row[variant], row[variant + "_note"] = None, "no LLVM library (install Debian's libllvm19)"
+            continue
+        row[variant], row[variant + "_note"] = mitsuba_times(scene, variant, args, libllvm)
+    return row
+
+
+def print_rows(rows, markdown):
+    def seconds(value):
+        return f"{value:.3f}" if value is not None else "—"
+
+    def rate(rays, time):
+        return f"{rays / time / 1e6:.1f} M" if time else "—"
+
+    header = ["scene", "ais 2 thr (s)", "ais rays/s", "Mitsuba llvm (s)", "llvm rays/s (nominal)",
+              "llvm / ais", "Mitsuba scalar (s)", "ais 1 thr (s)", "1 → 2 threads"]
+    lines = []
+    for row in rows:
+        llvm = row["llvm_ad_rgb"]
+        lines.append([row["scene"], seconds(row["ais_2"]), rate(row["ais_rays"], row["ais_2"]), seconds(llvm),
+                      rate(row["nominal_rays"], llvm), f"{llvm / row['ais_2']:.2f}×" if llvm else "—",
+                      seconds(row["scalar_rgb"]), seconds(row["ais_1"]), f"{row['scaling']:.2f}×"])
+    if markdown:
+        print("| " + " | ".join(header) + " |")
+        print("|" + "---|" * len(header))
+        for line in lines:
+            print("| " + " | ".join(line) + " |")
+    else:
+        widths = [max(len(str(x)) for x in column) for column in zip(header, *lines)]
+        for line in [header] + lines:
+            print("  ".join(str(x).ljust(w) for x, w in zip(line, widths)))
+    for row in rows:
+        for variant in ("llvm_ad_rgb", "scalar_rgb"):
+            if row.get(variant + "_note"):
+                print(f"note: {row['scene']}: {row[variant + '_note']}", file=sys.stderr)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter, epilog=__doc__)
+    parser.add_argument("scenes", nargs="+", help="Mitsuba XML scene files")
+    parser.add_argument("--setup", action="store_true", help="create --venv with Mitsuba and numpy, then run in it")
+    parser.add_argument("--venv", default=os.path.join(ROOT, ".venv"))
+    parser.add_argument("--size", default="128x128", help="film size for both renderers")
+    parser.add_argument("--spp", type=int, default=64, help="camera samples per pixel")
+    parser.add_argument("--rays", type=int, default=16, help="gather rays per camera sample (even)")
+    parser.add_argument("--runs", type=int, default=3, help="timed runs per renderer (medians)")
+    parser.add_argument("--timeout", type=int, default=900, help="seconds before a Mitsuba run is given up")
+    parser.add_argument("--ais", default=os.path.join(ROOT, "target", "release", "ais"), help="the ais binary")
+    parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
+    args = parser.parse_args()
+    if args.setup:
+        python = crosscheck.setup_venv(args.venv)
+        argv = [a for a in sys.argv[1:] if a != "--setup"]
+        sys.exit(subprocess.run([python, os.path.abspath(__file__)] + argv).returncode)
+    try:
+        import mitsuba  # noqa: F401
+    except ImportError as e:
+        crosscheck.fail_setup(f"{e}; run with --setup (makes .venv with Mitsuba and numpy)", crosscheck.NO_MITSUBA)
+    if not os.path.exists(args.ais):
+        crosscheck.fail_setup(f"{args.ais} not found; run `cargo build --release -p ais-cli` first")
+    if args.rays < 2 or args.rays % 2:
+        parser.error("--rays must be even: half emitter, half BSDF samples for Mitsuba")
+    crosscheck.ensure_assets()
+    libllvm = find_libllvm()
+    rows = []
+    for scene in args.scenes:
+        rows.append(measure(os.path.abspath(scene), args, libllvm))
+        print(f"bench: {scene} done", file=sys.stderr, flush=True)
+    print_rows(rows, args.markdown)
+
+
+if __name__ == "__main__":
+    main()
