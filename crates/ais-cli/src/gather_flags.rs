@@ -58,6 +58,10 @@ pub struct GatherFlags {
     /// map-use proposal: the guide's share of the proposal mixture, in [0, 0.99].
     #[arg(long)]
     guide_fraction: Option<String>,
+    /// map field (--ais auto): the cost ratio of a candidate's work besides tracing over
+    /// tracing's, or "measured" (the default; give a number to reproduce an image exactly).
+    #[arg(long)]
+    cost_ratio: Option<String>,
 }
 
 impl GatherFlags {
@@ -77,6 +81,7 @@ impl GatherFlags {
             "tol" => &self.tol,
             "map_res" => &self.map_res,
             "guide_fraction" => &self.guide_fraction,
+            "cost_ratio" => &self.cost_ratio,
             _ => &None,
         };
         value.as_deref()

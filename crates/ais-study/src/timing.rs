@@ -6,10 +6,10 @@
 //! in between, and that replay is timed as one region. The batch is deterministic, so the
 //! replay takes the same path; the image is not affected (the replay uses its own driver).
 
-use ais::field::FieldObservations;
 use ais::rng::Pcg32;
 use ais::{Batch, BatchConfig, Decision, MapStart};
 use ais_render::geometry::Ray;
+use ais_render::integrators::gather::FieldPass;
 use ais_render::integrators::gather::{
     gather, BatchProbe, GatherLearning, GatherSettings, GatherStats, GatherTile,
 };
@@ -139,9 +139,9 @@ impl TileStats for TimedStats {
 
 impl TileState for TimedTile {
     type Stats = TimedStats;
-    type Observed = Option<FieldObservations>;
+    type Observed = Option<FieldPass>;
 
-    fn take_observed(&mut self) -> Option<FieldObservations> {
+    fn take_observed(&mut self) -> Option<FieldPass> {
         self.0.take_observed()
     }
 

@@ -10,8 +10,8 @@ pub use ambient_occlusion::AmbientOcclusion;
 use crate::geometry::Ray;
 use crate::render::{RayCounts, SampleIntegrator, Tile, TileState};
 use crate::world::World;
-use ais::field::FieldObservations;
 use ais::rng::Pcg32;
+use gather::FieldPass;
 use gather::{GatherLearning, GatherSettings, GatherStats, GatherTile, MapSource};
 
 /// What to compute at each camera sample.
@@ -36,9 +36,9 @@ pub enum IntegratorTile {
 
 impl TileState for IntegratorTile {
     type Stats = GatherStats;
-    type Observed = Option<FieldObservations>;
+    type Observed = Option<FieldPass>;
 
-    fn take_observed(&mut self) -> Option<FieldObservations> {
+    fn take_observed(&mut self) -> Option<FieldPass> {
         match self {
             IntegratorTile::Gather(state) => state.take_observed(),
             IntegratorTile::Stateless => None,

@@ -65,6 +65,7 @@ pub fn snapshots(
         seed,
         start: ais::MapStart::Empty,
         field: None,
+        clock: None,
     };
     run_batch(
         &run,

@@ -135,6 +135,8 @@ pub struct VisibilityField {
     counts: Vec<TexelCounts>,
     /// Per cell, the sum of its texels' counts.
     totals: Vec<TexelCounts>,
+    /// Per cell, the lowest visibility of its texels.
+    darkest: Vec<f32>,
 }
 
 /// Texels per side of a cell's map by default: 64 texels of 0.2 sr each.
@@ -154,6 +156,7 @@ impl VisibilityField {
             cells: KeyMap::default(),
             counts: Vec::new(),
             totals: Vec::new(),
+            darkest: Vec::new(),
         }
     }
 
@@ -172,6 +175,7 @@ impl VisibilityField {
         std::mem::size_of::<Self>()
             + self.cells.capacity() * (std::mem::size_of::<(CellKey, u32)>() + 1)
             + (self.counts.capacity() + self.totals.capacity()) * std::mem::size_of::<TexelCounts>()
+            + self.darkest.capacity() * std::mem::size_of::<f32>()
     }
 
     /// The cell `key`, if any ray was ever recorded there.
@@ -183,6 +187,7 @@ impl VisibilityField {
         Some(FieldCell {
             counts: &self.counts[first as usize..first as usize + texels],
             total: self.totals[index],
+            darkest: self.darkest[index],
             side: self.side,
         })
     }
@@ -200,40 +205,53 @@ impl VisibilityField {
             if first == next as usize {
                 self.counts.resize(first + texels, TexelCounts::default());
                 self.totals.push(TexelCounts::default());
+                self.darkest.push(1.0);
             }
             let index = first / texels;
             for (texel, &count) in seen.iter().enumerate() {
                 self.counts[first + texel].add(count);
                 self.totals[index].add(count);
             }
+            self.darkest[index] = self.counts[first..first + texels]
+                .iter()
+                .map(|&c| visibility(c))
+                .fold(1.0, f32::min);
         }
     }
 }
 
-/// Pseudo-observations of a free ray added to every texel: a texel seen a few times keeps
-/// an acceptance near 1, and only evidence pulls it down.
+/// Pseudo-observations of a free ray added to every texel and cell: a texel seen a few
+/// times keeps a visibility near 1, and only evidence pulls it down.
 pub const PRIOR_FREE: f32 = 2.0;
 
 /// The lowest acceptance the field gives: a free ray in a texel the field calls blocked
 /// weighs at most 1 / this.
 pub const LOWEST_ACCEPTANCE: f32 = 0.1;
 
-/// A cell whose rays were free more often than this gains too little from roulette to pay
-/// for its lookups: its gathers trace every candidate and do no map work.
-pub const STAND_ASIDE_ABOVE: f32 = 0.6;
-
 /// A cell with fewer traced rays than this is not trusted yet: its gathers trace every
 /// candidate.
 pub const LEAST_EVIDENCE: u32 = 32;
 
-/// The acceptance probability for a candidate toward a texel with these counts: the square
-/// root (the cost-optimal shape when a rejected candidate costs about what a traced one
-/// costs, see the repository's docs/technique.md) of the texel's visibility with
-/// [`PRIOR_FREE`] free pseudo-observations, floored at [`LOWEST_ACCEPTANCE`].
+/// The visibility of counts with [`PRIOR_FREE`] free pseudo-observations.
 #[inline]
-pub fn acceptance(texel: TexelCounts) -> f32 {
-    let visibility = (texel.free as f32 + PRIOR_FREE) / (texel.traced as f32 + PRIOR_FREE);
-    visibility.sqrt().clamp(LOWEST_ACCEPTANCE, 1.0)
+pub fn visibility(counts: TexelCounts) -> f32 {
+    (counts.free as f32 + PRIOR_FREE) / (counts.traced as f32 + PRIOR_FREE)
+}
+
+/// The cost-optimal acceptance of a candidate toward a texel of visibility `texel` in a cell
+/// of visibility `cell`, when a candidate costs `cost_ratio` times what tracing it adds:
+///
+///   a = min(1, √((1 + ρ) · v_texel / v_cell)),  floored at [`LOWEST_ACCEPTANCE`].
+///
+/// It minimises variance × cost over a gather whose candidates carry alike (the derivation
+/// is in the repository's docs/technique.md). Tracing every candidate whose texel is at
+/// least `v_cell / (1 + ρ)` visible, it rolls only where rays are dear next to the rest of a
+/// candidate's work and the texel is much darker than the cell.
+#[inline]
+pub fn acceptance(texel: f32, cell: f32, cost_ratio: f32) -> f32 {
+    ((1.0 + cost_ratio) * texel / cell)
+        .sqrt()
+        .clamp(LOWEST_ACCEPTANCE, 1.0)
 }
 
 /// One cell of the field, for the lookups of one gather.
@@ -241,6 +259,8 @@ pub fn acceptance(texel: TexelCounts) -> f32 {
 pub struct FieldCell<'a> {
     counts: &'a [TexelCounts],
     total: TexelCounts,
+    /// The lowest visibility of its texels.
+    darkest: f32,
     side: u32,
 }
 
@@ -256,17 +276,26 @@ impl FieldCell<'_> {
         self.total
     }
 
-    /// Whether roulette can pay here: the cell has [`LEAST_EVIDENCE`] rays and at most
-    /// [`STAND_ASIDE_ABOVE`] of them were free.
-    pub fn worth_rolling(&self) -> bool {
-        self.total.traced >= LEAST_EVIDENCE
-            && (self.total.free as f32) <= STAND_ASIDE_ABOVE * self.total.traced as f32
+    /// The cell's visibility, with [`PRIOR_FREE`].
+    pub fn visibility(&self) -> f32 {
+        visibility(self.total)
+    }
+
+    /// Whether roulette can pay here at this cost ratio: the cell has [`LEAST_EVIDENCE`]
+    /// rays, and a texel dark enough that [`acceptance`] is below 1 there. Elsewhere a
+    /// gather should trace every candidate and do no map work.
+    pub fn worth_rolling(&self, cost_ratio: f32) -> bool {
+        self.total.traced >= LEAST_EVIDENCE && (1.0 + cost_ratio) * self.darkest < self.visibility()
     }
 
     /// [`acceptance`] toward `direction`.
     #[inline]
-    pub fn acceptance(&self, direction: [f32; 3]) -> f32 {
-        acceptance(self.texel(direction))
+    pub fn acceptance(&self, direction: [f32; 3], cost_ratio: f32) -> f32 {
+        acceptance(
+            visibility(self.texel(direction)),
+            self.visibility(),
+            cost_ratio,
+        )
     }
 }
 
@@ -414,16 +443,37 @@ mod tests {
     }
 
     #[test]
-    fn acceptance_trusts_evidence_and_only_evidence() {
-        let seen = |free, traced| acceptance(TexelCounts { free, traced });
+    fn acceptance_trusts_evidence_and_weighs_the_cost_of_a_ray() {
+        let seen = |free, traced| visibility(TexelCounts { free, traced });
         assert_eq!(seen(0, 0), 1.0);
-        assert!(seen(0, 3) > 0.6, "three blocked rays are not proof");
-        assert!((seen(0, 198) - 0.1).abs() < 1e-6, "the floor");
-        assert!(
-            (seen(23, 98) - 0.5).abs() < 1e-6,
-            "the square root of 25 / 100"
-        );
-        assert_eq!(seen(300, 300), 1.0);
+        assert!(seen(0, 3) > 0.39, "three blocked rays are not proof");
+        // A texel a quarter as visible as its cell, with candidates that cost as much as
+        // their rays (ρ = 1): √(2 · 1/4).
+        assert!((acceptance(0.1, 0.4, 1.0) - 0.5f32.sqrt()).abs() < 1e-6);
+        // Cheap rays next to the rest of a candidate's work: trace everything.
+        assert_eq!(acceptance(0.1, 0.4, 3.0), 1.0);
+        assert_eq!(acceptance(0.0, 0.4, 0.0), LOWEST_ACCEPTANCE);
+        assert_eq!(acceptance(0.5, 0.5, 0.0), 1.0);
+    }
+
+    #[test]
+    fn a_cell_stands_aside_unless_roulette_can_pay() {
+        let mut field = VisibilityField::new(4);
+        let key = CellKey::new([0.0; 3], [0.0, 1.0, 0.0], 0);
+        let mut observed = FieldObservations::new(4);
+        // Half the rays free, all toward +y; the rest blocked toward −x.
+        for k in 0..100 {
+            observed.record(key, [0.0, 1.0, 0.0], true);
+            observed.record(key, [-1.0, 0.0, 0.0], k % 50 == 0);
+        }
+        field.merge(&observed);
+        let cell = field.cell(&key).unwrap();
+        assert!(cell.worth_rolling(1.0), "a dark texel in a bright cell");
+        // √(2 · (2 + 2) / (100 + 2) / ((102 + 2) / (200 + 2))).
+        let expected = (2.0f32 * (4.0 / 102.0) / (104.0 / 202.0)).sqrt();
+        assert!((cell.acceptance([-1.0, 0.0, 0.0], 1.0) - expected).abs() < 1e-6);
+        assert_eq!(cell.acceptance([0.0, 1.0, 0.0], 1.0), 1.0);
+        assert!(!cell.worth_rolling(40.0), "rays too cheap to skip");
     }
 
     #[test]

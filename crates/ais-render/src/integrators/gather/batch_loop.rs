@@ -12,6 +12,8 @@ use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
 use ais::{rating, Batch, BatchConfig, Decision, MapStart};
 use glam::Vec3;
+use std::cell::Cell;
+use std::time::{Duration, Instant};
 
 /// Watches the calls a batch makes into the library, for studies (timing them, taking
 /// snapshots of the map). The renderer itself uses `()`, which watches nothing and costs
@@ -44,7 +46,18 @@ pub struct BatchRun<'a> {
     /// Whether the batch keeps the map it holds or starts from an empty one.
     pub start: MapStart,
     /// The learned field's cell, when it gives the acceptance (`map = field`).
-    pub field: Option<FieldCell<'a>>,
+    pub field: Option<FieldUse<'a>>,
+    /// When given, the time spent on accepted candidates is added to it.
+    pub clock: Option<&'a Cell<Duration>>,
+}
+
+/// The field's cell for one gather, and the cost ratio its acceptance uses.
+#[derive(Clone, Copy, Debug)]
+pub struct FieldUse<'a> {
+    /// The gather's cell.
+    pub cell: FieldCell<'a>,
+    /// ρ: what every candidate costs over what an accepted one adds.
+    pub cost_ratio: f32,
 }
 
 /// The running mean of earlier candidates' unoccluded values (value-aware acceptance).
@@ -88,11 +101,15 @@ pub fn run_batch<P: BatchProbe>(
         probe.decided(direction, in_support);
         let (decision, known) = decide(run, batch, &mut values, direction, in_support);
         if let Decision::Trace { .. } = decision {
+            let started = run.clock.map(|_| Instant::now());
             let (value, rating) = trace(run, direction, known, counts);
             if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), rating.free()) {
                 recorder.record(direction.into(), free);
             }
             batch.record(value.to_array(), rating.rating);
+            if let (Some(clock), Some(started)) = (run.clock, started) {
+                clock.set(clock.get() + started.elapsed());
+            }
             probe.recorded(batch, value.to_array(), rating.rating);
         }
     }
@@ -120,11 +137,12 @@ fn decide(
     in_support: bool,
 ) -> (Decision, Option<Known>) {
     let acceptance = run.settings.acceptance;
-    if let Some(cell) = &run.field {
+    if let Some(field) = &run.field {
         // Visibility alone: computing each candidate's value before deciding (to always
         // trace the bright ones) cost more time than it saved, measured on the rooms.
-        let decision =
-            batch.decide_with(direction, in_support, |_| cell.acceptance(direction.into()));
+        let decision = batch.decide_with(direction, in_support, |_| {
+            field.cell.acceptance(direction.into(), field.cost_ratio)
+        });
         return (decision, None);
     }
     if acceptance.needs_value() && in_support {

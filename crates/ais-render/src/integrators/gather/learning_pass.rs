@@ -142,6 +142,7 @@ impl LearningPass {
             seed: ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64,
             start: MapStart::Empty,
             field: None,
+            clock: None,
         };
         run_batch(&run, batch, counts, &mut (), None);
         let observations = batch

@@ -7,10 +7,12 @@
 //! - [`batch_loop`]: one batch through the library's driver;
 //! - [`learning_pass`]: maps learned around a tile before it renders (with the tile's
 //!   recent gathers of [`ais::shared`], the sources of shared maps);
-//! - [`guiding`]: a fixed map folded into the proposal.
+//! - [`guiding`]: a fixed map folded into the proposal;
+//! - [`field`]: acceptance from the visibility field learned between passes (`ais auto`).
 
 pub mod acceptance;
 pub mod batch_loop;
+pub mod field;
 pub mod guiding;
 pub mod learning_pass;
 mod light;
@@ -19,14 +21,15 @@ pub mod strategy;
 
 pub use acceptance::Acceptance;
 pub use batch_loop::{run_batch, BatchProbe, BatchRun};
+pub use field::{field_passes, CostSample, FieldPass, GatherLearning};
 pub use light::arriving_light;
 pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing, Update};
 pub use strategy::{gather_point, GatherPoint, Strategy};
 
 use crate::geometry::Ray;
-use crate::render::{Learning, RayCounts, Tile, TileState, TileStats};
+use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
-use ais::field::{CellKey, FieldObservations, VisibilityField};
+use ais::field::{FieldObservations, VisibilityField};
 use ais::rng::Pcg32;
 use ais::shared::{blend_neighbours, NeighbourSource, RecentGathers};
 use ais::{AffinityMap, Batch, MapStart};
@@ -38,55 +41,6 @@ use std::sync::Arc;
 /// The radius of a gather's neighbourhood among the tile's recent gathers, in pixel
 /// footprints at the gather point.
 pub const RADIUS_PIXELS: f32 = 3.0;
-
-/// The side of the visibility field's cells, in pixel footprints at the gather point.
-pub const FIELD_CELL_PIXELS: f32 = 4.0;
-
-/// Texels per side of a field cell's octahedral map (64 texels of 0.2 sr each).
-pub const FIELD_SIDE: u32 = ais::field::DEFAULT_SIDE;
-
-/// What the gather learns between passes: the visibility field (`map = field`).
-#[derive(Clone, Debug)]
-pub struct GatherLearning {
-    /// The field, shared read-only by the tiles of a pass.
-    pub field: Arc<VisibilityField>,
-}
-
-impl Default for GatherLearning {
-    fn default() -> Self {
-        GatherLearning {
-            field: Arc::new(VisibilityField::new(FIELD_SIDE)),
-        }
-    }
-}
-
-impl Learning for GatherLearning {
-    type Observed = Option<FieldObservations>;
-
-    fn merge(&mut self, observed: Option<FieldObservations>) {
-        if let Some(observed) = observed {
-            // The pass's tiles have dropped their handles: no copy is made.
-            Arc::make_mut(&mut self.field).merge(&observed);
-        }
-    }
-}
-
-/// Samples per pixel of each pass of a render with `map = field`: 1, 1, 2, 4, … doubling,
-/// the last taking what is left, so the field learns early and is used for most samples.
-pub fn field_passes(spp: u32) -> Vec<u32> {
-    let mut passes = Vec::new();
-    let (mut done, mut next) = (0u32, 1u32);
-    while done < spp {
-        let samples = if passes.len() < 2 { 1 } else { next };
-        let samples = samples.min(spp - done);
-        passes.push(samples);
-        done += samples;
-        if passes.len() >= 2 {
-            next = next.saturating_mul(2);
-        }
-    }
-    passes
-}
 
 /// What a render's gathers report: the batches' counters and the AIS memory a thread held.
 #[derive(Clone, Copy, Debug, Default)]
@@ -100,6 +54,9 @@ pub struct GatherStats {
     pub field_memory: usize,
     /// Gathers that used the field for roulette, and gathers where it stood aside.
     pub field_gathers: [u64; 2],
+    /// The cost ratio ρ (a candidate's work besides tracing, over tracing's) the field's
+    /// acceptance used in the last pass.
+    pub field_cost_ratio: f32,
 }
 
 impl TileStats for GatherStats {
@@ -110,6 +67,7 @@ impl TileStats for GatherStats {
         for (mine, theirs) in self.field_gathers.iter_mut().zip(other.field_gathers) {
             *mine += theirs;
         }
+        self.field_cost_ratio = self.field_cost_ratio.max(other.field_cost_ratio);
     }
 }
 
@@ -131,6 +89,12 @@ pub struct GatherTile<P: BatchProbe = ()> {
     observations: Option<FieldObservations>,
     /// Gathers that used the field, and gathers where it stood aside.
     field_gathers: [u64; 2],
+    /// The cost ratio the field's acceptance uses in this pass.
+    cost_ratio: f32,
+    /// This pass's timings of sampled gathers, for the next pass's cost ratio.
+    cost: CostSample,
+    /// Gathers run by this tile (to sample the timed ones).
+    gathers: u64,
     /// What watches the batches.
     pub probe: P,
 }
@@ -153,8 +117,11 @@ impl<P: BatchProbe> GatherTile<P> {
             learned: LearningPass::default(),
             guide: None,
             field: learning.field.clone(),
-            observations: field.then(|| FieldObservations::new(FIELD_SIDE)),
+            observations: field.then(|| FieldObservations::new(field::FIELD_SIDE)),
             field_gathers: [0; 2],
+            cost_ratio: learning.cost_ratio(settings),
+            cost: CostSample::default(),
+            gathers: 0,
             probe,
         };
         if let (true, Sharing::LearningPass { stride }) = (settings.shares_maps(), settings.sharing)
@@ -193,10 +160,14 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
         self.batch.as_ref().map_or(0, |b| b.stats().traced)
     }
 
-    type Observed = Option<FieldObservations>;
+    type Observed = Option<FieldPass>;
 
-    fn take_observed(&mut self) -> Option<FieldObservations> {
-        self.observations.take()
+    fn take_observed(&mut self) -> Option<FieldPass> {
+        let observations = self.observations.take()?;
+        Some(FieldPass {
+            observations,
+            cost: std::mem::take(&mut self.cost),
+        })
     }
 
     fn finish(self) -> GatherStats {
@@ -209,6 +180,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
                 0
             },
             field_gathers: self.field_gathers,
+            field_cost_ratio: self.cost_ratio,
         }
     }
 }
@@ -269,7 +241,7 @@ fn guided_sampler<'g>(
 
 /// The tile's batch driver, made on first use for `settings` (observing its rays when the
 /// gathers share maps).
-fn batch_for<'b>(
+pub(super) fn batch_for<'b>(
     slot: &'b mut Option<Batch<[f32; 3]>>,
     settings: &GatherSettings,
 ) -> &'b mut Batch<[f32; 3]> {
@@ -304,16 +276,8 @@ pub fn gather<P: BatchProbe>(
     let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if settings.map == MapSource::Field {
-        let site = FieldSite {
-            key: CellKey::new(
-                hit.point.into(),
-                hit.geometric_normal.into(),
-                CellKey::level_for(FIELD_CELL_PIXELS * footprint),
-            ),
-            at: &at,
-            seed,
-        };
-        return emitted + field_gather(world, settings, &site, state, counts);
+        let site = field::FieldSite::new(&hit, &at, footprint, seed);
+        return emitted + field::field_gather(world, settings, &site, state, counts);
     }
     let sharing = settings.shares_maps();
     let batch = batch_for(&mut state.batch, settings);
@@ -345,6 +309,7 @@ pub fn gather<P: BatchProbe>(
         seed,
         start,
         field: None,
+        clock: None,
     };
     let value = run_batch(&run, batch, counts, &mut state.probe, None);
     if sharing {
@@ -356,45 +321,4 @@ pub fn gather<P: BatchProbe>(
             .remember(hit.point, at.frame.normal, observations);
     }
     emitted + value
-}
-
-/// Where a `map = field` gather happens.
-struct FieldSite<'a> {
-    /// Its cell of the field.
-    key: CellKey,
-    /// The gather point.
-    at: &'a GatherPoint<'a>,
-    /// The batch's scrambling seed.
-    seed: u64,
-}
-
-/// A gather with acceptance from the learned field: roulette where the field's cell says it
-/// pays, every candidate traced (and no map work) elsewhere. Its traced rays are recorded
-/// for the next pass's field.
-fn field_gather<P: BatchProbe>(
-    world: &World,
-    settings: &GatherSettings,
-    site: &FieldSite,
-    state: &mut GatherTile<P>,
-    counts: &mut RayCounts,
-) -> Vec3 {
-    let field = state.field.clone();
-    let cell = field.cell(&site.key).filter(|cell| cell.worth_rolling());
-    state.field_gathers[usize::from(cell.is_none())] += 1;
-    let sampler = CandidateSampler::plain(settings.strategy);
-    let run = BatchRun {
-        world,
-        settings,
-        at: site.at,
-        sampler: &sampler,
-        seed: site.seed,
-        start: MapStart::Empty,
-        field: cell,
-    };
-    let batch = batch_for(&mut state.batch, settings);
-    let mut recorder = state
-        .observations
-        .as_mut()
-        .map(|observations| observations.cell_mut(site.key));
-    run_batch(&run, batch, counts, &mut state.probe, recorder.as_mut())
 }

@@ -16,6 +16,7 @@
 //! | `tol` | float | 1 | the map's floor, a_min = 1/(tol·h²); `inf` for none |
 //! | `map_res` | integer | 4 | the map's height h in texels (width 2h), 1 to 1024 |
 //! | `guide_fraction` | float | 0.5 | `map_use = proposal`: the guide's share of the proposal, in [0, 0.99] |
+//! | `cost_ratio` | float or `measured` | `measured` | `map = field`: ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass unless given (give it to make an image reproducible bit for bit) |
 //!
 //! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
 //! `update`; `shared` = `map neighbours`; `warm` = `map neighbours, update aggressive`;
@@ -30,7 +31,7 @@ use crate::scene::{Plugin, Property};
 use ais::{BatchConfig, MapConfig, Mode, Stopping};
 
 /// The parameter names, in the order they apply (a preset before the settings it bundles).
-pub const PARAMETERS: [&str; 13] = [
+pub const PARAMETERS: [&str; 14] = [
     "strategy",
     "rays",
     "budget",
@@ -44,6 +45,7 @@ pub const PARAMETERS: [&str; 13] = [
     "tol",
     "map_res",
     "guide_fraction",
+    "cost_ratio",
 ];
 
 /// Most rays (candidates) per gather.
@@ -220,6 +222,9 @@ pub struct GatherSettings {
     pub map_height: u32,
     /// `map_use = proposal`: the guide's share α of the proposal mixture `(1 − α) p + α g`.
     pub guide_fraction: f32,
+    /// `map = field`: the cost ratio ρ (a candidate's work besides tracing, over what
+    /// tracing it adds) its acceptance uses; `None`: measured in the render.
+    pub cost_ratio: Option<f32>,
 }
 
 impl Default for GatherSettings {
@@ -243,6 +248,7 @@ impl Default for GatherSettings {
             tol: map.tol,
             map_height: map.height,
             guide_fraction: super::guiding::GUIDE_FRACTION,
+            cost_ratio: None,
         }
     }
 }
@@ -398,6 +404,12 @@ impl GatherSettings {
             "tol" => self.tol = number(value, "tol")?,
             "map_res" => self.map_height = number(value, "map_res")?,
             "guide_fraction" => self.guide_fraction = number(value, "guide_fraction")?,
+            "cost_ratio" => {
+                self.cost_ratio = match value {
+                    "measured" => None,
+                    _ => Some(number(value, "cost_ratio")?),
+                }
+            }
             _ => {
                 return Err(format!(
                     "unknown gather parameter \"{name}\" (known: {})",
@@ -459,6 +471,11 @@ impl GatherSettings {
         }
         if !(0.0..=0.99).contains(&self.guide_fraction) {
             return Err("guide_fraction must lie in [0, 0.99]".into());
+        }
+        if let Some(ratio) = self.cost_ratio {
+            if !(0.0..=1e6).contains(&ratio) {
+                return Err("cost_ratio must lie in [0, 1e6] (or be \"measured\")".into());
+            }
         }
         self.validate_map()
     }

@@ -1,0 +1,209 @@
+//! The gather with the visibility field (`map = field`, preset `auto`): acceptance from the
+//! field learned in earlier passes, standing aside where roulette cannot pay, and what a
+//! pass gives back: its rays, and what a candidate and a traced ray cost in this render.
+
+use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse};
+use super::guiding::CandidateSampler;
+use super::strategy::GatherPoint;
+use super::{batch_for, GatherSettings, GatherTile};
+use crate::geometry::Hit;
+use crate::render::{Learning, RayCounts};
+use crate::world::World;
+use ais::field::{CellKey, FieldObservations, VisibilityField};
+use ais::MapStart;
+use glam::Vec3;
+use std::cell::Cell;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
+
+/// The side of the field's cells, in pixel footprints at the gather point.
+pub const FIELD_CELL_PIXELS: f32 = 4.0;
+
+/// Texels per side of a field cell's octahedral map.
+pub const FIELD_SIDE: u32 = ais::field::DEFAULT_SIDE;
+
+/// One gather in this many is timed to measure the cost ratio.
+pub const TIMED_ONE_IN: u64 = 16;
+
+/// The cost ratio used before anything was measured (and when nothing could be).
+pub const UNMEASURED_COST_RATIO: f32 = 1.0;
+
+/// Samples per pixel of each pass of a render with `map = field`: 1, 1, 2, 4, … doubling,
+/// the last taking what is left, so the field learns early and is used for most samples.
+pub fn field_passes(spp: u32) -> Vec<u32> {
+    let mut passes = Vec::new();
+    let (mut done, mut next) = (0u32, 1u32);
+    while done < spp {
+        let samples = if passes.len() < 2 { 1 } else { next };
+        let samples = samples.min(spp - done);
+        passes.push(samples);
+        done += samples;
+        if passes.len() >= 2 {
+            next = next.saturating_mul(2);
+        }
+    }
+    passes
+}
+
+/// Timings of sampled gathers: whole gathers, and the part spent on accepted candidates
+/// (density, unoccluded radiance, the occlusion ray, the BSDF, recording).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CostSample {
+    /// Time in the timed gathers.
+    pub gathers: Duration,
+    /// Of which, time on accepted candidates.
+    pub traced: Duration,
+    /// Candidates drawn in the timed gathers.
+    pub candidates: u64,
+    /// Of which, accepted.
+    pub accepted: u64,
+}
+
+impl CostSample {
+    fn add(&mut self, other: CostSample) {
+        self.gathers += other.gathers;
+        self.traced += other.traced;
+        self.candidates += other.candidates;
+        self.accepted += other.accepted;
+    }
+
+    /// ρ = (what every candidate costs) / (what an accepted one adds), rounded to a power of
+    /// √2 in [1/16, 16] so that timing noise rarely moves it; `None` without timings.
+    pub fn ratio(&self) -> Option<f32> {
+        if self.candidates == 0 || self.accepted == 0 || self.traced.is_zero() {
+            return None;
+        }
+        let per_candidate =
+            self.gathers.saturating_sub(self.traced).as_secs_f64() / self.candidates as f64;
+        let per_traced = self.traced.as_secs_f64() / self.accepted as f64;
+        let ratio = per_candidate / per_traced;
+        let steps = (2.0 * ratio.log2()).round().clamp(-8.0, 8.0);
+        Some(2f64.powf(steps / 2.0) as f32)
+    }
+}
+
+/// What a tile gives back after a pass: its rays, and its timings.
+#[derive(Clone, Debug)]
+pub struct FieldPass {
+    /// The rays traced, counted per cell and texel.
+    pub observations: FieldObservations,
+    /// Timings of its sampled gathers.
+    pub cost: CostSample,
+}
+
+/// What the gather learns between passes: the visibility field and the measured costs.
+#[derive(Clone, Debug)]
+pub struct GatherLearning {
+    /// The field, shared read-only by the tiles of a pass.
+    pub field: Arc<VisibilityField>,
+    /// The timings of every pass so far.
+    pub cost: CostSample,
+}
+
+impl Default for GatherLearning {
+    fn default() -> Self {
+        GatherLearning {
+            field: Arc::new(VisibilityField::new(FIELD_SIDE)),
+            cost: CostSample::default(),
+        }
+    }
+}
+
+impl GatherLearning {
+    /// The cost ratio the next pass uses: the settings' `cost_ratio` if given, else the one
+    /// measured so far.
+    pub fn cost_ratio(&self, settings: &GatherSettings) -> f32 {
+        settings
+            .cost_ratio
+            .or_else(|| self.cost.ratio())
+            .unwrap_or(UNMEASURED_COST_RATIO)
+    }
+}
+
+impl Learning for GatherLearning {
+    type Observed = Option<FieldPass>;
+
+    fn merge(&mut self, observed: Option<FieldPass>) {
+        if let Some(pass) = observed {
+            // The pass's tiles have dropped their handles: no copy is made.
+            Arc::make_mut(&mut self.field).merge(&pass.observations);
+            self.cost.add(pass.cost);
+        }
+    }
+}
+
+/// Where a `map = field` gather happens.
+pub(super) struct FieldSite<'a> {
+    /// Its cell of the field.
+    key: CellKey,
+    /// The gather point.
+    at: &'a GatherPoint<'a>,
+    /// The batch's scrambling seed.
+    seed: u64,
+}
+
+impl<'a> FieldSite<'a> {
+    /// The gather at `hit` (point `at`, pixel footprint `footprint`), seeded with `seed`.
+    pub fn new(hit: &Hit, at: &'a GatherPoint<'a>, footprint: f32, seed: u64) -> Self {
+        FieldSite {
+            key: CellKey::new(
+                hit.point.into(),
+                hit.geometric_normal.into(),
+                CellKey::level_for(FIELD_CELL_PIXELS * footprint),
+            ),
+            at,
+            seed,
+        }
+    }
+}
+
+/// A gather with acceptance from the learned field: roulette where the field's cell says it
+/// pays at this render's cost ratio, every candidate traced (and no map work) elsewhere. Its
+/// traced rays are recorded for the next pass's field; one gather in [`TIMED_ONE_IN`] is
+/// timed for the next pass's cost ratio.
+pub(super) fn field_gather<P: BatchProbe>(
+    world: &World,
+    settings: &GatherSettings,
+    site: &FieldSite,
+    state: &mut GatherTile<P>,
+    counts: &mut RayCounts,
+) -> Vec3 {
+    let field = state.field.clone();
+    let cost_ratio = state.cost_ratio;
+    let cell = field
+        .cell(&site.key)
+        .filter(|cell| cell.worth_rolling(cost_ratio));
+    state.field_gathers[usize::from(cell.is_none())] += 1;
+    state.gathers += 1;
+    let clock = Cell::new(Duration::ZERO);
+    let timed = settings.cost_ratio.is_none() && state.gathers.is_multiple_of(TIMED_ONE_IN);
+    let sampler = CandidateSampler::plain(settings.strategy);
+    let run = BatchRun {
+        world,
+        settings,
+        at: site.at,
+        sampler: &sampler,
+        seed: site.seed,
+        start: MapStart::Empty,
+        field: cell.map(|cell| FieldUse { cell, cost_ratio }),
+        clock: timed.then_some(&clock),
+    };
+    let batch = batch_for(&mut state.batch, settings);
+    let before = *batch.stats();
+    let mut recorder = state
+        .observations
+        .as_mut()
+        .map(|observations| observations.cell_mut(site.key));
+    let started = Instant::now();
+    let value = run_batch(&run, batch, counts, &mut state.probe, recorder.as_mut());
+    if timed {
+        let after = batch.stats();
+        state.cost.add(CostSample {
+            gathers: started.elapsed(),
+            traced: clock.get(),
+            candidates: after.candidates - before.candidates,
+            accepted: after.traced - before.traced,
+        });
+    }
+    value
+}

@@ -1,0 +1,82 @@
+#!/usr/bin/env python3
+"""Efficiency of AIS configurations against AIS off, per scene and n, at one spp each.
+
+    cargo build --release -p ais-cli
+    python3 tools/crosscheck.py --setup          # makes .venv (Mitsuba reads the EXRs)
+    SEEDS=5 .venv/bin/python tools/field_study.py 80x60 sunlit_room,interior off,auto 16,128
+
+For each scene of scenes/ (names without .xml), a reference is rendered once by ais with AIS
+off at 1024 spp and 16 rays (cached in target/field-study/). Then every configuration renders
+SEEDS times (default 8) at `--spp` 32 for n = 16 and 8 for n = 128, in one process, and the
+script prints per configuration the mean relMSE against the reference (relMSE = mean((x − r)²
+/ (r² + 0.01))) with its standard error over seeds, the mean render time, and the
+efficiency ratio against the first configuration: (relMSE · time) of the first over that of
+the row, with its noise from the two relMSE standard errors. Configurations whose learning
+happens between passes (auto) render their spp in passes, so one render is the right unit
+here; `ais compare` renders 1 spp per pass and cannot show them.
+"""
+import os
+import re
+import subprocess
+import sys
+
+import mitsuba as mi
+import numpy as np
+
+mi.set_variant('scalar_rgb')
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+AIS = os.path.join(ROOT, 'target', 'release', 'ais')
+WORK = os.path.join(ROOT, 'target', 'field-study')
+SPP_FOR = {16: 32, 128: 8}
+
+
+def render(scene, size, spp, rays, ais, seed, out):
+    command = [AIS, 'render', os.path.join(ROOT, 'scenes', scene + '.xml'), '--resolution', size,
+               '--spp', str(spp), '--rays', str(rays), '--ais', ais, '--seed', str(seed),
+               '--no-preview', '-o', out]
+    done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode:
+        sys.exit(done.stderr)
+    report = done.stdout + done.stderr
+    seconds = float(re.search(r'render time\s+([0-9.]+)', report).group(1))
+    counts = re.search(r'traced ([0-9.]+), rejected outside support ([0-9.]+), by roulette ([0-9.]+)', report)
+    return np.array(mi.Bitmap(out))[..., :3].astype(np.float64), seconds, counts.groups() if counts else ()
+
+
+def rel_mse(image, reference):
+    return float(np.mean((image - reference) ** 2 / (reference ** 2 + 0.01)))
+
+
+def main():
+    size, scenes = sys.argv[1], sys.argv[2].split(',')
+    configs = sys.argv[3].split(',') if len(sys.argv) > 3 else ['off', 'auto']
+    ns = [int(n) for n in (sys.argv[4] if len(sys.argv) > 4 else '16,128').split(',')]
+    seeds = int(os.environ.get('SEEDS', '8'))
+    os.makedirs(WORK, exist_ok=True)
+    for scene in scenes:
+        reference_path = os.path.join(WORK, f'reference-{scene}-{size}.exr')
+        if not os.path.exists(reference_path):
+            render(scene, size, 1024, 16, 'off', 777, reference_path)
+        reference = np.array(mi.Bitmap(reference_path))[..., :3].astype(np.float64)
+        for n in ns:
+            rows = {}
+            for config in configs:
+                errors, times, counts = [], [], ()
+                for seed in range(seeds):
+                    out = os.path.join(WORK, f'{scene}-{config}.exr')
+                    image, seconds, counts = render(scene, size, SPP_FOR[n], n, config, seed, out)
+                    errors.append(rel_mse(image, reference))
+                    times.append(seconds)
+                rows[config] = (np.mean(errors), np.std(errors) / np.sqrt(seeds), np.mean(times), counts)
+            base_error, base_se, base_time, _ = rows[configs[0]]
+            for config in configs:
+                error, se, seconds, counts = rows[config]
+                efficiency = base_error * base_time / (error * seconds)
+                noise = efficiency * np.hypot(se / error, base_se / base_error)
+                per_gather = f'traced {counts[0]}, rejected {counts[2]} per gather' if counts else ''
+                print(f'{scene:14s} n={n:3d} {config:6s} relMSE {error:.3e}±{se:.1e} time {seconds:.3f}s  '
+                      f'efficiency {efficiency:.2f}× ±{noise:.2f}  {per_gather}', flush=True)
+
+
+if __name__ == '__main__':
+    main()
