@@ -62,6 +62,15 @@ pub struct GatherFlags {
     /// tracing's, or "measured" (the default; give a number to reproduce an image exactly).
     #[arg(long)]
     cost_ratio: Option<String>,
+    /// map field: texels per side of a cell's octahedral map (1 to 64).
+    #[arg(long)]
+    field_res: Option<String>,
+    /// map field: a cell's edge in pixel footprints.
+    #[arg(long)]
+    field_cell: Option<String>,
+    /// map field: free pseudo-observations per texel and cell.
+    #[arg(long)]
+    field_prior: Option<String>,
 }
 
 impl GatherFlags {
@@ -82,6 +91,9 @@ impl GatherFlags {
             "map_res" => &self.map_res,
             "guide_fraction" => &self.guide_fraction,
             "cost_ratio" => &self.cost_ratio,
+            "field_res" => &self.field_res,
+            "field_cell" => &self.field_cell,
+            "field_prior" => &self.field_prior,
             _ => &None,
         };
         value.as_deref()

@@ -62,6 +62,8 @@ impl SampleIntegrator for Oracle {
     type Learned = ();
     type Tile = OracleTile;
 
+    fn new_learning(&self) {}
+
     fn begin_tile(&self, _: &World, _: &Tile, _: &(), _: &mut RayCounts) -> OracleTile {
         OracleTile::default()
     }

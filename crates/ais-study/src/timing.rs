@@ -166,6 +166,10 @@ impl SampleIntegrator for TimedGather {
         Integrator::Gather(self.0).passes(spp)
     }
 
+    fn new_learning(&self) -> GatherLearning {
+        GatherLearning::new(&self.0)
+    }
+
     fn begin_tile(
         &self,
         world: &World,

@@ -73,6 +73,13 @@ impl SampleIntegrator for Integrator {
         }
     }
 
+    fn new_learning(&self) -> GatherLearning {
+        match self {
+            Integrator::Gather(settings) => GatherLearning::new(settings),
+            _ => GatherLearning::new(&GatherSettings::default()),
+        }
+    }
+
     fn begin_tile(
         &self,
         world: &World,

@@ -20,7 +20,7 @@ impl TileStats for () {
 /// What an integrator learns over a render: state that every tile of a pass reads and
 /// that changes only between passes, from what the pass's tiles observed. Fixed within a
 /// pass, it keeps each pass unbiased and the image independent of threads.
-pub trait Learning: Default + Sync {
+pub trait Learning: Sync {
     /// What one tile observed in a pass.
     type Observed: Send;
 
@@ -73,6 +73,9 @@ pub trait SampleIntegrator: Sync {
     fn passes(&self, spp: u32) -> Vec<u32> {
         vec![spp]
     }
+
+    /// What it knows before the first pass.
+    fn new_learning(&self) -> Self::Learned;
 
     /// The state for `tile`, reading what was learned before this pass; work done here (a
     /// learning pass, say) counts its rays in `counts`.

@@ -124,7 +124,7 @@ pub fn render<I: SampleIntegrator>(
     let passes = integrator.passes(settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
-    let mut learned = I::Learned::default();
+    let mut learned = integrator.new_learning();
     let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(width, height);
     for (index, &samples) in passes.iter().enumerate() {
         let pass = Pass {

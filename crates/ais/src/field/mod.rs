@@ -130,6 +130,8 @@ type KeyMap<V> = HashMap<CellKey, V, BuildHasherDefault<KeyHasher>>;
 #[derive(Clone, Debug)]
 pub struct VisibilityField {
     side: u32,
+    /// Free pseudo-observations added to every texel and cell.
+    prior: f32,
     /// Cell → index of its first texel in `counts`.
     cells: KeyMap<u32>,
     counts: Vec<TexelCounts>,
@@ -153,10 +155,24 @@ impl VisibilityField {
     pub fn new(side: u32) -> Self {
         VisibilityField {
             side: side.clamp(1, 64),
+            prior: PRIOR_FREE,
             cells: KeyMap::default(),
             counts: Vec::new(),
             totals: Vec::new(),
             darkest: Vec::new(),
+        }
+    }
+
+    /// This field with `prior` free pseudo-observations per texel and cell instead of
+    /// [`PRIOR_FREE`] (negative or non-finite values count as 0).
+    pub fn with_prior(self, prior: f32) -> Self {
+        VisibilityField {
+            prior: if prior.is_finite() {
+                prior.max(0.0)
+            } else {
+                0.0
+            },
+            ..self
         }
     }
 
@@ -189,6 +205,7 @@ impl VisibilityField {
             total: self.totals[index],
             darkest: self.darkest[index],
             side: self.side,
+            prior: self.prior,
         })
     }
 
@@ -214,7 +231,7 @@ impl VisibilityField {
             }
             self.darkest[index] = self.counts[first..first + texels]
                 .iter()
-                .map(|&c| visibility(c))
+                .map(|&c| visibility(c, self.prior))
                 .fold(1.0, f32::min);
         }
     }
@@ -232,10 +249,15 @@ pub const LOWEST_ACCEPTANCE: f32 = 0.1;
 /// candidate.
 pub const LEAST_EVIDENCE: u32 = 32;
 
-/// The visibility of counts with [`PRIOR_FREE`] free pseudo-observations.
+/// The visibility of counts with `prior` free pseudo-observations (1 with no evidence).
 #[inline]
-pub fn visibility(counts: TexelCounts) -> f32 {
-    (counts.free as f32 + PRIOR_FREE) / (counts.traced as f32 + PRIOR_FREE)
+pub fn visibility(counts: TexelCounts, prior: f32) -> f32 {
+    let traced = counts.traced as f32 + prior;
+    if traced > 0.0 {
+        (counts.free as f32 + prior) / traced
+    } else {
+        1.0
+    }
 }
 
 /// The cost-optimal acceptance of a candidate toward a texel of visibility `texel` in a cell
@@ -262,6 +284,7 @@ pub struct FieldCell<'a> {
     /// The lowest visibility of its texels.
     darkest: f32,
     side: u32,
+    prior: f32,
 }
 
 impl FieldCell<'_> {
@@ -276,9 +299,9 @@ impl FieldCell<'_> {
         self.total
     }
 
-    /// The cell's visibility, with [`PRIOR_FREE`].
+    /// The cell's visibility, with the field's prior.
     pub fn visibility(&self) -> f32 {
-        visibility(self.total)
+        visibility(self.total, self.prior)
     }
 
     /// Whether roulette can pay here at this cost ratio: the cell has [`LEAST_EVIDENCE`]
@@ -292,7 +315,7 @@ impl FieldCell<'_> {
     #[inline]
     pub fn acceptance(&self, direction: [f32; 3], cost_ratio: f32) -> f32 {
         acceptance(
-            visibility(self.texel(direction)),
+            visibility(self.texel(direction), self.prior),
             self.visibility(),
             cost_ratio,
         )
@@ -444,7 +467,7 @@ mod tests {
 
     #[test]
     fn acceptance_trusts_evidence_and_weighs_the_cost_of_a_ray() {
-        let seen = |free, traced| visibility(TexelCounts { free, traced });
+        let seen = |free, traced| visibility(TexelCounts { free, traced }, PRIOR_FREE);
         assert_eq!(seen(0, 0), 1.0);
         assert!(seen(0, 3) > 0.39, "three blocked rays are not proof");
         // A texel a quarter as visible as its cell, with candidates that cost as much as

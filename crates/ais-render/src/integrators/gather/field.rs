@@ -16,34 +16,35 @@ use std::cell::Cell;
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
-/// The side of the field's cells, in pixel footprints at the gather point.
-pub const FIELD_CELL_PIXELS: f32 = 4.0;
-
-/// Texels per side of a field cell's octahedral map.
-pub const FIELD_SIDE: u32 = ais::field::DEFAULT_SIDE;
-
 /// One gather in this many is timed to measure the cost ratio.
 pub const TIMED_ONE_IN: u64 = 16;
 
 /// The cost ratio used before anything was measured (and when nothing could be).
 pub const UNMEASURED_COST_RATIO: f32 = 1.0;
 
-/// Samples per pixel of each pass of a render with `map = field`: 1, 1, 2, 4, … doubling,
-/// the last taking what is left, so the field learns early and is used for most samples.
+/// Samples per pixel of the passes of a render with `map = field`: 1, 1, 2, then the rest,
+/// so the field learns early and is used for most samples. (Each pass ends with a barrier
+/// where a core may wait for the last tile: more passes cost more.)
 pub fn field_passes(spp: u32) -> Vec<u32> {
     let mut passes = Vec::new();
-    let (mut done, mut next) = (0u32, 1u32);
-    while done < spp {
-        let samples = if passes.len() < 2 { 1 } else { next };
+    let mut done = 0u32;
+    for samples in [1, 1, 2, u32::MAX] {
         let samples = samples.min(spp - done);
+        if samples == 0 {
+            break;
+        }
         passes.push(samples);
         done += samples;
-        if passes.len() >= 2 {
-            next = next.saturating_mul(2);
-        }
     }
     passes
 }
+
+/// A cell with this many rays in the field learns from one gather in
+/// [`WELL_KNOWN_RECORD_ONE_IN`] only: recording costs time, and it knows enough.
+pub const WELL_KNOWN: u32 = 512;
+
+/// See [`WELL_KNOWN`].
+pub const WELL_KNOWN_RECORD_ONE_IN: u64 = 4;
 
 /// Timings of sampled gathers: whole gathers, and the part spent on accepted candidates
 /// (density, unoccluded radiance, the occlusion ray, the BSDF, recording).
@@ -100,16 +101,16 @@ pub struct GatherLearning {
     pub cost: CostSample,
 }
 
-impl Default for GatherLearning {
-    fn default() -> Self {
+impl GatherLearning {
+    /// An empty field for these settings (`field_res`, `field_prior`).
+    pub fn new(settings: &GatherSettings) -> Self {
+        let field = VisibilityField::new(settings.field_res).with_prior(settings.field_prior);
         GatherLearning {
-            field: Arc::new(VisibilityField::new(FIELD_SIDE)),
+            field: Arc::new(field),
             cost: CostSample::default(),
         }
     }
-}
 
-impl GatherLearning {
     /// The cost ratio the next pass uses: the settings' `cost_ratio` if given, else the one
     /// measured so far.
     pub fn cost_ratio(&self, settings: &GatherSettings) -> f32 {
@@ -143,13 +144,20 @@ pub(super) struct FieldSite<'a> {
 }
 
 impl<'a> FieldSite<'a> {
-    /// The gather at `hit` (point `at`, pixel footprint `footprint`), seeded with `seed`.
-    pub fn new(hit: &Hit, at: &'a GatherPoint<'a>, footprint: f32, seed: u64) -> Self {
+    /// The gather at `hit` (point `at`, pixel footprint `footprint`), seeded with `seed`,
+    /// in a cell `cell_pixels` footprints wide.
+    pub fn new(
+        hit: &Hit,
+        at: &'a GatherPoint<'a>,
+        footprint: f32,
+        cell_pixels: f32,
+        seed: u64,
+    ) -> Self {
         FieldSite {
             key: CellKey::new(
                 hit.point.into(),
                 hit.geometric_normal.into(),
-                CellKey::level_for(FIELD_CELL_PIXELS * footprint),
+                CellKey::level_for(cell_pixels * footprint),
             ),
             at,
             seed,
@@ -168,15 +176,26 @@ pub(super) fn field_gather<P: BatchProbe>(
     state: &mut GatherTile<P>,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    let field = state.field.clone();
-    let cost_ratio = state.cost_ratio;
-    let cell = field
-        .cell(&site.key)
-        .filter(|cell| cell.worth_rolling(cost_ratio));
-    state.field_gathers[usize::from(cell.is_none())] += 1;
-    state.gathers += 1;
+    let GatherTile {
+        batch,
+        field,
+        observations,
+        field_gathers,
+        cost_ratio,
+        cost,
+        gathers,
+        probe,
+        ..
+    } = state;
+    let cost_ratio = *cost_ratio;
+    let known = field.cell(&site.key);
+    let record = known.is_none_or(|cell| cell.total().traced < WELL_KNOWN)
+        || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN);
+    let cell = known.filter(|cell| cell.worth_rolling(cost_ratio));
+    field_gathers[usize::from(cell.is_none())] += 1;
+    *gathers += 1;
     let clock = Cell::new(Duration::ZERO);
-    let timed = settings.cost_ratio.is_none() && state.gathers.is_multiple_of(TIMED_ONE_IN);
+    let timed = settings.cost_ratio.is_none() && gathers.is_multiple_of(TIMED_ONE_IN);
     let sampler = CandidateSampler::plain(settings.strategy);
     let run = BatchRun {
         world,
@@ -188,17 +207,17 @@ pub(super) fn field_gather<P: BatchProbe>(
         field: cell.map(|cell| FieldUse { cell, cost_ratio }),
         clock: timed.then_some(&clock),
     };
-    let batch = batch_for(&mut state.batch, settings);
+    let batch = batch_for(batch, settings);
     let before = *batch.stats();
-    let mut recorder = state
-        .observations
+    let mut recorder = observations
         .as_mut()
+        .filter(|_| record)
         .map(|observations| observations.cell_mut(site.key));
     let started = Instant::now();
-    let value = run_batch(&run, batch, counts, &mut state.probe, recorder.as_mut());
+    let value = run_batch(&run, batch, counts, probe, recorder.as_mut());
     if timed {
         let after = batch.stats();
-        state.cost.add(CostSample {
+        cost.add(CostSample {
             gathers: started.elapsed(),
             traced: clock.get(),
             candidates: after.candidates - before.candidates,

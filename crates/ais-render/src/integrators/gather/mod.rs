@@ -76,7 +76,7 @@ impl TileStats for GatherStats {
 #[derive(Default)]
 pub struct GatherTile<P: BatchProbe = ()> {
     /// The batch driver (allocated on first use).
-    batch: Option<Batch<[f32; 3]>>,
+    pub(super) batch: Option<Batch<[f32; 3]>>,
     /// The tile's recent gathers, for shared maps in tile order.
     recent: RecentGathers,
     /// The learning pass around this tile, for shared maps from a learning pass.
@@ -84,17 +84,17 @@ pub struct GatherTile<P: BatchProbe = ()> {
     /// The guide distributions of `map_use = proposal` (allocated on first use).
     guide: Option<Guide>,
     /// The visibility field learned in earlier passes (`map = field`).
-    field: Arc<VisibilityField>,
+    pub(super) field: Arc<VisibilityField>,
     /// The rays this tile traced in this pass, for the field (`map = field`).
-    observations: Option<FieldObservations>,
+    pub(super) observations: Option<FieldObservations>,
     /// Gathers that used the field, and gathers where it stood aside.
-    field_gathers: [u64; 2],
+    pub(super) field_gathers: [u64; 2],
     /// The cost ratio the field's acceptance uses in this pass.
-    cost_ratio: f32,
+    pub(super) cost_ratio: f32,
     /// This pass's timings of sampled gathers, for the next pass's cost ratio.
-    cost: CostSample,
+    pub(super) cost: CostSample,
     /// Gathers run by this tile (to sample the timed ones).
-    gathers: u64,
+    pub(super) gathers: u64,
     /// What watches the batches.
     pub probe: P,
 }
@@ -117,7 +117,7 @@ impl<P: BatchProbe> GatherTile<P> {
             learned: LearningPass::default(),
             guide: None,
             field: learning.field.clone(),
-            observations: field.then(|| FieldObservations::new(field::FIELD_SIDE)),
+            observations: field.then(|| FieldObservations::new(learning.field.side())),
             field_gathers: [0; 2],
             cost_ratio: learning.cost_ratio(settings),
             cost: CostSample::default(),
@@ -276,7 +276,7 @@ pub fn gather<P: BatchProbe>(
     let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if settings.map == MapSource::Field {
-        let site = field::FieldSite::new(&hit, &at, footprint, seed);
+        let site = field::FieldSite::new(&hit, &at, footprint, settings.field_cell, seed);
         return emitted + field::field_gather(world, settings, &site, state, counts);
     }
     let sharing = settings.shares_maps();

@@ -16,6 +16,9 @@
 //! | `tol` | float | 1 | the map's floor, a_min = 1/(tol·h²); `inf` for none |
 //! | `map_res` | integer | 4 | the map's height h in texels (width 2h), 1 to 1024 |
 //! | `guide_fraction` | float | 0.5 | `map_use = proposal`: the guide's share of the proposal, in [0, 0.99] |
+//! | `field_res` | integer | 8 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
+//! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
+//! | `field_prior` | float | 2 | `map = field`: free pseudo-observations added to every texel and cell (how much evidence it takes to call a direction blocked) |
 //! | `cost_ratio` | float or `measured` | `measured` | `map = field`: ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass unless given (give it to make an image reproducible bit for bit) |
 //!
 //! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
@@ -31,7 +34,7 @@ use crate::scene::{Plugin, Property};
 use ais::{BatchConfig, MapConfig, Mode, Stopping};
 
 /// The parameter names, in the order they apply (a preset before the settings it bundles).
-pub const PARAMETERS: [&str; 14] = [
+pub const PARAMETERS: [&str; 17] = [
     "strategy",
     "rays",
     "budget",
@@ -46,6 +49,9 @@ pub const PARAMETERS: [&str; 14] = [
     "map_res",
     "guide_fraction",
     "cost_ratio",
+    "field_res",
+    "field_cell",
+    "field_prior",
 ];
 
 /// Most rays (candidates) per gather.
@@ -225,6 +231,12 @@ pub struct GatherSettings {
     /// `map = field`: the cost ratio ρ (a candidate's work besides tracing, over what
     /// tracing it adds) its acceptance uses; `None`: measured in the render.
     pub cost_ratio: Option<f32>,
+    /// `map = field`: texels per side of a cell's octahedral map.
+    pub field_res: u32,
+    /// `map = field`: a cell's edge, in pixel footprints at the gather point.
+    pub field_cell: f32,
+    /// `map = field`: free pseudo-observations added to every texel and cell.
+    pub field_prior: f32,
 }
 
 impl Default for GatherSettings {
@@ -249,6 +261,9 @@ impl Default for GatherSettings {
             map_height: map.height,
             guide_fraction: super::guiding::GUIDE_FRACTION,
             cost_ratio: None,
+            field_res: ais::field::DEFAULT_SIDE,
+            field_cell: 4.0,
+            field_prior: ais::field::PRIOR_FREE,
         }
     }
 }
@@ -404,6 +419,9 @@ impl GatherSettings {
             "tol" => self.tol = number(value, "tol")?,
             "map_res" => self.map_height = number(value, "map_res")?,
             "guide_fraction" => self.guide_fraction = number(value, "guide_fraction")?,
+            "field_res" => self.field_res = number(value, "field_res")?,
+            "field_cell" => self.field_cell = number(value, "field_cell")?,
+            "field_prior" => self.field_prior = number(value, "field_prior")?,
             "cost_ratio" => {
                 self.cost_ratio = match value {
                     "measured" => None,
@@ -471,6 +489,15 @@ impl GatherSettings {
         }
         if !(0.0..=0.99).contains(&self.guide_fraction) {
             return Err("guide_fraction must lie in [0, 0.99]".into());
+        }
+        if !(1..=64).contains(&self.field_res) {
+            return Err("field_res must lie in 1..=64".into());
+        }
+        if !(self.field_cell > 0.0 && self.field_cell <= 1e6) {
+            return Err("field_cell must lie in (0, 1e6]".into());
+        }
+        if !(0.0..=1e6).contains(&self.field_prior) {
+            return Err("field_prior must lie in [0, 1e6]".into());
         }
         if let Some(ratio) = self.cost_ratio {
             if !(0.0..=1e6).contains(&ratio) {
