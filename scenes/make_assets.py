@@ -45,29 +45,38 @@ def radiance(x, y, z):
 BLOB_COLUMNS, BLOB_ROWS = 100, 75
 
 
-def write_blob(path):
-    """A UV sphere whose radius is modulated by bumps: 2 x 100 x 74 triangles."""
+def uv_sphere(columns, rows, radius):
+    """The OBJ lines of a UV sphere with outward winding: `rows` + 1 rings of `columns`
+    vertices at distance radius(theta, phi) from the centre, 2 x columns x (rows - 1)
+    triangles."""
     lines = []
-    for row in range(BLOB_ROWS + 1):
-        theta = math.pi * row / BLOB_ROWS
-        for column in range(BLOB_COLUMNS):
-            phi = 2.0 * math.pi * column / BLOB_COLUMNS
-            r = 1.0 + 0.08 * math.sin(7.0 * theta) * math.sin(9.0 * phi)
+    for row in range(rows + 1):
+        theta = math.pi * row / rows
+        for column in range(columns):
+            phi = 2.0 * math.pi * column / columns
+            r = radius(theta, phi)
             x = r * math.sin(theta) * math.cos(phi)
             y = r * math.cos(theta)
             z = r * math.sin(theta) * math.sin(phi)
             lines.append(f"v {x:.6f} {y:.6f} {z:.6f}")
+
     def index(row, column):
-        return row * BLOB_COLUMNS + column % BLOB_COLUMNS + 1
-    for row in range(BLOB_ROWS):
-        for column in range(BLOB_COLUMNS):
+        return row * columns + column % columns + 1
+    for row in range(rows):
+        for column in range(columns):
             a, b = index(row, column), index(row, column + 1)
             c, d = index(row + 1, column + 1), index(row + 1, column)
             if row > 0:
                 lines.append(f"f {a} {b} {c}")
-            if row < BLOB_ROWS - 1:
+            if row < rows - 1:
                 lines.append(f"f {a} {c} {d}")
-    write_obj(path, lines)
+    return lines
+
+
+def write_blob(path):
+    """A UV sphere whose radius is modulated by bumps: 2 x 100 x 74 triangles."""
+    bumps = lambda theta, phi: 1.0 + 0.08 * math.sin(7.0 * theta) * math.sin(9.0 * phi)
+    write_obj(path, uv_sphere(BLOB_COLUMNS, BLOB_ROWS, bumps))
 
 
 def write_obj(path, lines):
@@ -113,25 +122,7 @@ BALL_COLUMNS, BALL_ROWS = 60, 67
 
 def write_ball(path):
     """A UV sphere of radius 1 with outward winding: 2 x 60 x 66 triangles."""
-    lines = []
-    for row in range(BALL_ROWS + 1):
-        theta = math.pi * row / BALL_ROWS
-        for column in range(BALL_COLUMNS):
-            phi = 2.0 * math.pi * column / BALL_COLUMNS
-            lines.append(f"v {math.sin(theta) * math.cos(phi):.6f} {math.cos(theta):.6f} "
-                         f"{math.sin(theta) * math.sin(phi):.6f}")
-
-    def index(row, column):
-        return row * BALL_COLUMNS + column % BALL_COLUMNS + 1
-    for row in range(BALL_ROWS):
-        for column in range(BALL_COLUMNS):
-            a, b = index(row, column), index(row, column + 1)
-            c, d = index(row + 1, column + 1), index(row + 1, column)
-            if row > 0:
-                lines.append(f"f {a} {b} {c}")
-            if row < BALL_ROWS - 1:
-                lines.append(f"f {a} {c} {d}")
-    write_obj(path, lines)
+    write_obj(path, uv_sphere(BALL_COLUMNS, BALL_ROWS, lambda theta, phi: 1.0))
 
 
 def main():

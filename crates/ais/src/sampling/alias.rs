@@ -32,18 +32,7 @@ impl AliasTable {
     /// all-zero (or empty) input gives the uniform distribution, so that sampling stays
     /// defined.
     pub fn new(weights: &[f64]) -> Self {
-        let mut clean: Vec<f64> = weights
-            .iter()
-            .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
-            .collect();
-        if clean.is_empty() {
-            clean.push(0.0);
-        }
-        let total: f64 = clean.iter().sum();
-        if total <= 0.0 {
-            clean.iter_mut().for_each(|w| *w = 1.0);
-        }
-        let sum: f64 = clean.iter().sum();
+        let (clean, total, sum) = super::distribution::sampling_weights(weights);
         let probabilities: Vec<f32> = clean.iter().map(|&w| (w / sum) as f32).collect();
         AliasTable {
             bins: build_bins(&clean, sum),

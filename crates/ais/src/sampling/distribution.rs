@@ -16,24 +16,32 @@ pub struct Distribution1D {
     guide: Vec<u32>,
 }
 
+/// Weights made usable for sampling: negative and non-finite ones count as zero, an empty
+/// input is one bin, and all-zero weights become uniform. Returns them, the sum of the
+/// original (cleaned) weights, and the sum of the returned ones.
+pub(crate) fn sampling_weights(weights: &[f64]) -> (Vec<f64>, f64, f64) {
+    let mut clean: Vec<f64> = weights
+        .iter()
+        .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
+        .collect();
+    if clean.is_empty() {
+        clean.push(0.0);
+    }
+    let total: f64 = clean.iter().sum();
+    if total <= 0.0 {
+        clean.iter_mut().for_each(|w| *w = 1.0);
+    }
+    let sum = clean.iter().sum();
+    (clean, total, sum)
+}
+
 impl Distribution1D {
     /// A distribution proportional to `weights`. An all-zero (or empty) input gives a uniform
     /// distribution, so that sampling stays defined.
     pub fn new(weights: &[f64]) -> Self {
         let n = weights.len().max(1);
-        let mut clean: Vec<f64> = weights
-            .iter()
-            .map(|&w| if w.is_finite() && w > 0.0 { w } else { 0.0 })
-            .collect();
-        if clean.is_empty() {
-            clean.push(0.0);
-        }
-        let total: f64 = clean.iter().sum();
+        let (clean, total, sum) = sampling_weights(weights);
         let integral = total / n as f64;
-        if total <= 0.0 {
-            clean.iter_mut().for_each(|w| *w = 1.0);
-        }
-        let sum: f64 = clean.iter().sum();
         let mut cdf = Vec::with_capacity(n + 1);
         cdf.push(0.0);
         let mut running = 0.0;

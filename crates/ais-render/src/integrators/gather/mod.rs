@@ -26,7 +26,7 @@ pub use light::arriving_light;
 pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing, Update};
 pub use strategy::{gather_point, GatherPoint, Strategy};
 
-use crate::geometry::Ray;
+use crate::geometry::{Hit, Ray};
 use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
 use ais::field::{FieldObservations, VisibilityField};
@@ -272,13 +272,43 @@ pub fn gather<P: BatchProbe>(
     if world.lights.is_empty() {
         return emitted;
     }
-    let mut at = gather_point(world, &hit, -ray.direction);
+    let at = gather_point(world, &hit, -ray.direction);
     let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if settings.map == MapSource::Field {
         let site = field::FieldSite::new(&hit, &at, footprint, settings.field_cell, seed);
         return emitted + field::field_gather(world, settings, &site, state, counts);
     }
+    let site = MapSite {
+        hit: &hit,
+        footprint,
+        seed,
+    };
+    emitted + map_gather(world, settings, &site, at, state, counts)
+}
+
+/// Where a gather with the batch's own map (or none) happens.
+struct MapSite<'a> {
+    /// The first hit.
+    hit: &'a Hit,
+    /// The pixel footprint there.
+    footprint: f32,
+    /// The batch's scrambling seed.
+    seed: u64,
+}
+
+/// A gather whose batch starts from an empty map, from its neighbours' maps (shared maps),
+/// or has none (AIS off).
+fn map_gather<P: BatchProbe>(
+    world: &World,
+    settings: &GatherSettings,
+    site: &MapSite,
+    at: GatherPoint,
+    state: &mut GatherTile<P>,
+    counts: &mut RayCounts,
+) -> Vec3 {
+    // A guided gather points `at` at a guide borrowed from `state`: a shorter lifetime.
+    let mut at: GatherPoint<'_> = at;
     let sharing = settings.shares_maps();
     let batch = batch_for(&mut state.batch, settings);
     let mut sampler = CandidateSampler::plain(settings.strategy);
@@ -288,9 +318,9 @@ pub fn gather<P: BatchProbe>(
             recent: &state.recent,
             learned: &state.learned,
             sharing: settings.sharing,
-            footprint,
+            footprint: site.footprint,
         };
-        let found = neighbourhood.blend_into(map, hit.point, at.frame.normal);
+        let found = neighbourhood.blend_into(map, site.hit.point, at.frame.normal);
         if settings.map_use == MapUse::Proposal && found > 0 {
             let guide = state
                 .guide
@@ -306,7 +336,7 @@ pub fn gather<P: BatchProbe>(
         settings,
         at: &at,
         sampler: &sampler,
-        seed,
+        seed: site.seed,
         start,
         field: None,
         clock: None,
@@ -318,7 +348,7 @@ pub fn gather<P: BatchProbe>(
             .expect("shared maps observe their rays");
         state
             .recent
-            .remember(hit.point, at.frame.normal, observations);
+            .remember(site.hit.point, at.frame.normal, observations);
     }
-    emitted + value
+    value
 }
