@@ -1,10 +1,10 @@
-//! Area lights: spheres (sampled uniformly inside the subtended cone) and triangle meshes,
-//! including Mitsuba's rectangles (area-weighted triangle choice, uniform points on the
-//! triangle). Emission is one-sided, toward the surface normal, as in Mitsuba.
+//! Area lights: spheres (sampled uniformly inside the subtended cone), rectangles (by solid
+//! angle) and triangle meshes ([`MeshEmitter`]: area-weighted triangle choice, uniform points
+//! on the triangle, a BVH for densities and hits). Emission is one-sided, toward the surface normal, as in Mitsuba.
 
+use super::mesh_emitter::MeshEmitter;
 use super::spherical_rectangle::Rectangle;
 use crate::geometry::{Ray, Sphere, Triangle};
-use ais::sampling::Distribution1D;
 use glam::Vec3;
 use std::f64::consts::PI;
 
@@ -21,14 +21,7 @@ pub enum AreaShape {
     /// A rectangle, sampled uniformly in the solid angle it subtends.
     Rectangle(Rectangle),
     /// Triangles, each emitting toward the side of its (possibly flipped) winding normal.
-    Triangles {
-        /// World-space triangles, already wound so that the emitting side is front.
-        triangles: Vec<Triangle>,
-        /// Area-proportional choice of a triangle.
-        choice: Distribution1D,
-        /// Total area.
-        area: f64,
-    },
+    Triangles(Box<MeshEmitter>),
 }
 
 /// A light sample: where it points and what it sends.
@@ -69,17 +62,8 @@ fn subtended_cone(sphere: &Sphere, point: Vec3) -> Option<(Vec3, f64)> {
 impl AreaLight {
     /// Triangles (wound toward the emitting side) as a light.
     pub fn from_triangles(triangles: Vec<Triangle>, radiance: Vec3, shape_index: u32) -> Self {
-        let areas: Vec<f64> = triangles
-            .iter()
-            .map(|t| 0.5 * t.normal().length() as f64)
-            .collect();
-        let area = areas.iter().sum();
         AreaLight {
-            shape: AreaShape::Triangles {
-                choice: Distribution1D::new(&areas),
-                triangles,
-                area,
-            },
+            shape: AreaShape::Triangles(Box::new(MeshEmitter::new(triangles))),
             radiance,
             shape_index,
         }
@@ -90,7 +74,7 @@ impl AreaLight {
         let area = match &self.shape {
             AreaShape::Sphere { sphere, .. } => 4.0 * PI * (sphere.radius as f64).powi(2),
             AreaShape::Rectangle(rectangle) => rectangle.area(),
-            AreaShape::Triangles { area, .. } => *area,
+            AreaShape::Triangles(mesh) => mesh.area(),
         };
         PI * super::luminance(self.radiance) as f64 * area
     }
@@ -127,34 +111,9 @@ impl AreaLight {
                 let (direction, pdf) = rectangle.sample(point, u)?;
                 Some(AreaSample { direction, pdf })
             }
-            AreaShape::Triangles {
-                triangles,
-                choice,
-                area,
-            } => {
-                let (x, _, index) = choice.sample(u[0] as f64);
-                // The position within the chosen bin is a fresh uniform number.
-                let u0 = (x * choice.len() as f64 - index as f64).clamp(0.0, 1.0);
-                let triangle = &triangles[index];
-                let su = u0.sqrt();
-                let (b1, b2) = (1.0 - su, u[1] as f64 * su);
-                let [v0, v1, v2] = triangle.vertices;
-                let target = v0 * (1.0 - b1 - b2) as f32 + v1 * b1 as f32 + v2 * b2 as f32;
-                let offset = target - point;
-                let distance_squared = offset.length_squared() as f64;
-                if distance_squared == 0.0 {
-                    return None;
-                }
-                let direction = offset.normalize();
-                let normal = triangle.normal().normalize();
-                let cosine = normal.dot(direction).abs() as f64;
-                if cosine <= 0.0 {
-                    return None;
-                }
-                Some(AreaSample {
-                    direction,
-                    pdf: distance_squared / (cosine * area),
-                })
+            AreaShape::Triangles(mesh) => {
+                let (direction, pdf) = mesh.sample(point, u)?;
+                Some(AreaSample { direction, pdf })
             }
         }
     }
@@ -182,20 +141,7 @@ impl AreaLight {
                     0.0
                 }
             }
-            AreaShape::Triangles {
-                triangles, area, ..
-            } => {
-                // A direction may cross several triangles of a non-convex mesh: densities add.
-                let ray = Ray::new(point, direction);
-                triangles
-                    .iter()
-                    .filter_map(|triangle| {
-                        let (t, _) = triangle.intersect(&ray, f32::INFINITY)?;
-                        let cosine = triangle.normal().normalize().dot(direction).abs() as f64;
-                        (cosine > 0.0).then(|| (t as f64).powi(2) / (cosine * area))
-                    })
-                    .sum()
-            }
+            AreaShape::Triangles(mesh) => mesh.pdf(point, direction),
         }
     }
 
@@ -210,13 +156,7 @@ impl AreaLight {
             AreaShape::Rectangle(rectangle) => {
                 rectangle.intersect(ray).map(|t| (t, rectangle.normal))
             }
-            AreaShape::Triangles { triangles, .. } => triangles
-                .iter()
-                .filter_map(|tri| {
-                    tri.intersect(ray, ray.t_max)
-                        .map(|(t, _)| (t, tri.normal().normalize()))
-                })
-                .min_by(|a, b| a.0.total_cmp(&b.0)),
+            AreaShape::Triangles(mesh) => mesh.intersect(ray),
         }
     }
 }

@@ -4,11 +4,13 @@
 mod area;
 mod environment;
 mod environment_guide;
+mod mesh_emitter;
 mod spherical_rectangle;
 
 pub use area::{AreaLight, AreaSample, AreaShape};
 pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
+pub use mesh_emitter::MeshEmitter;
 pub use spherical_rectangle::Rectangle;
 
 use crate::geometry::Ray;

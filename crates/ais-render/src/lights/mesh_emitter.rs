@@ -1,0 +1,138 @@
+//! An emitting triangle mesh: a triangle chosen in proportion to its area by an alias table,
+//! a uniform point on it, and its own BVH so that the density of a direction and the
+//! nearest emitting point along a ray cost O(log n) rather than a loop over the triangles.
+//!
+//! A direction may cross several triangles of a non-convex mesh. Light sampling reaches
+//! each crossing point, and the gather takes the radiance of the nearest one, so the
+//! density of a direction is the sum over all its crossings of distance² / (|cos| · area).
+
+use crate::geometry::{Ray, Triangle};
+use ais::sampling::AliasTable;
+use glam::{Vec3, Vec3A};
+use obvhs::cwbvh::CwBvh;
+use std::time::Duration;
+
+/// An emitting triangle mesh, in world space.
+#[derive(Clone, Debug)]
+pub struct MeshEmitter {
+    /// World-space triangles, wound so that the emitting side is front, in BVH order.
+    triangles: Vec<Triangle>,
+    /// Area-proportional choice of a triangle.
+    choice: AliasTable,
+    /// Total area.
+    area: f64,
+    bvh: CwBvh,
+}
+
+/// Bounds of one triangle, for the BVH build.
+struct Bounded<'a>(&'a Triangle);
+
+impl obvhs::Boundable for Bounded<'_> {
+    fn aabb(&self) -> obvhs::aabb::Aabb {
+        let [a, b, c] = self.0.vertices.map(Vec3A::from);
+        obvhs::aabb::Aabb::new(a.min(b).min(c), a.max(b).max(c))
+    }
+}
+
+impl MeshEmitter {
+    /// The mesh of `triangles` (at least one).
+    pub fn new(triangles: Vec<Triangle>) -> Self {
+        let bounded: Vec<Bounded> = triangles.iter().map(Bounded).collect();
+        let bvh = obvhs::cwbvh::builder::build_cwbvh(
+            &bounded,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let triangles: Vec<Triangle> = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| triangles[i as usize])
+            .collect();
+        let areas: Vec<f64> = triangles
+            .iter()
+            .map(|t| 0.5 * t.normal().length() as f64)
+            .collect();
+        MeshEmitter {
+            choice: AliasTable::new(&areas),
+            area: areas.iter().sum(),
+            triangles,
+            bvh,
+        }
+    }
+
+    /// Total area.
+    pub fn area(&self) -> f64 {
+        self.area
+    }
+
+    /// A direction from `point` toward a uniformly chosen point of the mesh, and its density
+    /// in solid angle for that triangle alone (the caller adds the other crossings through
+    /// [`MeshEmitter::pdf`] when it needs the full density).
+    pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
+        let (index, u0) = self.choice.sample(u[0]);
+        let triangle = &self.triangles[index];
+        let su = u0.sqrt();
+        let (b1, b2) = (1.0 - su, u[1] * su);
+        let [v0, v1, v2] = triangle.vertices;
+        let target = v0 * (1.0 - b1 - b2) + v1 * b1 + v2 * b2;
+        let offset = target - point;
+        let distance_squared = offset.length_squared() as f64;
+        if distance_squared == 0.0 {
+            return None;
+        }
+        let direction = offset.normalize();
+        let cosine = triangle.normal().normalize().dot(direction).abs() as f64;
+        (cosine > 0.0).then(|| (direction, distance_squared / (cosine * self.area)))
+    }
+
+    /// The density of [`MeshEmitter::sample`] toward `direction` from `point`: the sum over
+    /// every triangle the direction crosses.
+    pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
+        let ray = Ray::new(point, direction);
+        let mut density = 0.0;
+        self.bvh.ray_traverse(
+            Self::bvh_ray(&ray, f32::INFINITY),
+            &mut obvhs::ray::RayHit::none(),
+            |_, id| {
+                let triangle = &self.triangles[id];
+                if let Some((t, _)) = triangle.intersect(&ray, f32::INFINITY) {
+                    let cosine = triangle.normal().normalize().dot(direction).abs() as f64;
+                    if cosine > 0.0 {
+                        density += (t as f64).powi(2) / (cosine * self.area);
+                    }
+                }
+                // Never shorten the ray: every crossing counts.
+                f32::INFINITY
+            },
+        );
+        density
+    }
+
+    /// The nearest point of the mesh along `ray` (within `ray.t_max`): its distance and the
+    /// triangle's geometric normal there.
+    pub fn intersect(&self, ray: &Ray) -> Option<(f32, Vec3)> {
+        let mut hit = obvhs::ray::RayHit::none();
+        let mut nearest: Option<(f32, usize)> = None;
+        self.bvh.ray_traverse(
+            Self::bvh_ray(ray, ray.t_max),
+            &mut hit,
+            |r, id| match self.triangles[id].intersect(ray, r.tmax) {
+                Some((t, _)) => {
+                    nearest = Some((t, id));
+                    t
+                }
+                None => f32::INFINITY,
+            },
+        );
+        nearest.map(|(t, id)| (t, self.triangles[id].normal().normalize()))
+    }
+
+    fn bvh_ray(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
+        obvhs::ray::Ray::new(
+            Vec3A::from(ray.origin),
+            Vec3A::from(ray.direction),
+            0.0,
+            t_max,
+        )
+    }
+}
