@@ -54,6 +54,9 @@ pub struct EnvironmentMap {
     mean_luminance: f64,
     /// Its cells grouped by map texels, for guided light sampling.
     partitions: super::environment_guide::PartitionCache,
+    /// Unique among the maps of a process (clones share it, and their contents), to key
+    /// the last lookup of each thread.
+    id: u64,
 }
 
 /// Where a direction falls on an environment map: Mitsuba's (u, v) and the sampling cell.
@@ -104,13 +107,33 @@ impl EnvironmentMap {
             row_cosines: row_cosines.iter().map(|&c| c as f32).collect(),
             mean_luminance: total / (4.0 * PI),
             partitions: Default::default(),
+            id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
+    }
+
+    /// [`EnvironmentMap::locate`], remembering the last direction of this thread: a traced
+    /// candidate asks for its density and then its radiance, so the second lookup is free.
+    #[inline]
+    fn locate(&self, direction: Vec3) -> MapLocation {
+        thread_local! {
+            static LAST: std::cell::Cell<Option<(u64, [u32; 3], MapLocation)>> =
+                const { std::cell::Cell::new(None) };
+        }
+        let key = (self.id, direction.to_array().map(f32::to_bits));
+        LAST.with(|last| match last.get() {
+            Some((map, bits, location)) if (map, bits) == key => location,
+            _ => {
+                let location = self.locate_anew(direction);
+                last.set(Some((key.0, key.1, location)));
+                location
+            }
+        })
     }
 
     /// Where `direction` (unit, world space) falls: Mitsuba's u = atan2(x, −z) / 2π ∈ [0, 1)
     /// and v = acos(y) / π ∈ [0, 1] in the emitter's frame, and the sampling cell there.
     #[inline]
-    fn locate(&self, direction: Vec3) -> MapLocation {
+    fn locate_anew(&self, direction: Vec3) -> MapLocation {
         let d = self.to_local * direction;
         let mut u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI32);
         if u < 0.0 {
@@ -251,6 +274,9 @@ fn cell_weights(image: &RgbImage, row_cosines: &[f64]) -> Vec<f64> {
 
 /// The largest f32 below 1.
 const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The next [`EnvironmentMap`]'s id.
+static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl Environment {
     /// Radiance arriving from `direction` (unit, world space).
