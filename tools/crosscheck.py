@@ -87,9 +87,13 @@ def setup_venv(venv):
 
 
 def mitsuba_scene_text(text, width, height, samples):
-    """The scene for Mitsuba: its `direct` integrator, our film size and a box filter."""
+    """The scene for Mitsuba: its `direct` integrator (keeping the scene's hide_emitters), our
+    film size and a box filter."""
+    hidden = re.search(r'<integrator\b.*?<boolean\s+name="hide_emitters"\s+value="true"\s*/>.*?</integrator>',
+                       text, flags=re.S)
+    hide = '<boolean name="hide_emitters" value="true"/>' if hidden else ''
     direct = (f'<integrator type="direct"><integer name="emitter_samples" value="{samples}"/>'
-              f'<integer name="bsdf_samples" value="{samples}"/></integrator>')
+              f'<integer name="bsdf_samples" value="{samples}"/>{hide}</integrator>')
     text, count = re.subn(r"<integrator\b[^>]*/>|<integrator\b[^>]*[^/]>.*?</integrator>",
                           direct, text, count=1, flags=re.S)
     if count == 0:

@@ -71,6 +71,9 @@ pub struct GatherFlags {
     /// map field: free pseudo-observations per texel and cell.
     #[arg(long)]
     field_prior: Option<String>,
+    /// Mitsuba's hide_emitters: "true" hides the emitters the camera sees directly.
+    #[arg(long)]
+    hide_emitters: Option<String>,
 }
 
 impl GatherFlags {
@@ -94,6 +97,7 @@ impl GatherFlags {
             "field_res" => &self.field_res,
             "field_cell" => &self.field_cell,
             "field_prior" => &self.field_prior,
+            "hide_emitters" => &self.hide_emitters,
             _ => &None,
         };
         value.as_deref()
@@ -102,10 +106,23 @@ impl GatherFlags {
     /// Gather settings: defaults, then the scene's `<integrator type="gather">` properties
     /// (`plugin`, read from `file`), then these flags.
     pub fn settings(&self, file: &Path, plugin: Option<&Plugin>) -> Result<GatherSettings, String> {
-        let mut settings = match plugin.filter(|p| p.kind == "gather") {
-            Some(plugin) => GatherSettings::from_properties(plugin)
-                .map_err(|(line, message)| format!("{}:{line}: {message}", file.display()))?,
-            None => GatherSettings::default(),
+        let at = |(line, message): (u32, String)| format!("{}:{line}: {message}", file.display());
+        let mut settings = match plugin {
+            Some(plugin) if plugin.kind == "gather" => {
+                GatherSettings::from_properties(plugin).map_err(at)?
+            }
+            Some(plugin) if plugin.kind == "direct" || plugin.kind == "path" => {
+                let read = GatherSettings::from_mitsuba_integrator(plugin).map_err(at)?;
+                for (name, line) in read.ignored {
+                    eprintln!(
+                        "warning: {}:{line}: \"{name}\" of integrator \"{}\" is ignored (the gather takes --rays and --strategy)",
+                        file.display(),
+                        plugin.kind
+                    );
+                }
+                read.settings
+            }
+            _ => GatherSettings::default(),
         };
         self.apply(&mut settings)?;
         Ok(settings)

@@ -264,11 +264,18 @@ pub fn gather<P: BatchProbe>(
 ) -> Vec3 {
     counts.closest_hit += 1;
     let Some(hit) = world.geometry.intersect(ray) else {
+        if settings.hide_emitters {
+            return Vec3::ZERO;
+        }
         return world.lights.background(ray.direction);
     };
-    let emitted = world
-        .lights
-        .emitted(hit.shape, hit.geometric_normal, ray.direction);
+    let emitted = if settings.hide_emitters {
+        Vec3::ZERO
+    } else {
+        world
+            .lights
+            .emitted(hit.shape, hit.geometric_normal, ray.direction)
+    };
     if world.lights.is_empty() {
         return emitted;
     }

@@ -19,6 +19,7 @@
 //! | `field_res` | integer | 8 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
 //! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: free pseudo-observations added to every texel and cell (how much evidence it takes to call a direction blocked) |
+//! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
 //! | `cost_ratio` | float or `measured` | `measured` | `map = field`: ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass unless given (give it to make an image reproducible bit for bit) |
 //!
 //! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
@@ -34,7 +35,7 @@ use crate::scene::{Plugin, Property};
 use ais::{BatchConfig, MapConfig, Mode, Stopping};
 
 /// The parameter names, in the order they apply (a preset before the settings it bundles).
-pub const PARAMETERS: [&str; 17] = [
+pub const PARAMETERS: [&str; 18] = [
     "strategy",
     "rays",
     "budget",
@@ -52,6 +53,7 @@ pub const PARAMETERS: [&str; 17] = [
     "field_res",
     "field_cell",
     "field_prior",
+    "hide_emitters",
 ];
 
 /// Most rays (candidates) per gather.
@@ -201,6 +203,14 @@ pub enum RayBudget {
     Candidates,
 }
 
+/// A Mitsuba `direct` or `path` integrator read as gather settings.
+pub struct MitsubaIntegrator {
+    /// The settings: the defaults with its `hide_emitters`.
+    pub settings: GatherSettings,
+    /// Its properties the gather does not use, with their lines.
+    pub ignored: Vec<(String, u32)>,
+}
+
 /// Settings of the multi-ray gather integrator (see the module's parameter table).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct GatherSettings {
@@ -237,6 +247,9 @@ pub struct GatherSettings {
     pub field_cell: f32,
     /// `map = field`: free pseudo-observations added to every texel and cell.
     pub field_prior: f32,
+    /// Mitsuba's `hide_emitters`: camera rays add no emission of the emitters they hit
+    /// directly, and the environment seen directly is black.
+    pub hide_emitters: bool,
 }
 
 impl Default for GatherSettings {
@@ -264,6 +277,7 @@ impl Default for GatherSettings {
             field_res: ais::field::DEFAULT_SIDE,
             field_cell: 4.0,
             field_prior: ais::field::PRIOR_FREE,
+            hide_emitters: false,
         }
     }
 }
@@ -419,6 +433,13 @@ impl GatherSettings {
             "tol" => self.tol = number(value, "tol")?,
             "map_res" => self.map_height = number(value, "map_res")?,
             "guide_fraction" => self.guide_fraction = number(value, "guide_fraction")?,
+            "hide_emitters" => {
+                self.hide_emitters = match value {
+                    "true" => true,
+                    "false" => false,
+                    _ => return Err(format!("hide_emitters \"{value}\" is not true or false")),
+                }
+            }
             "field_res" => self.field_res = number(value, "field_res")?,
             "field_cell" => self.field_cell = number(value, "field_cell")?,
             "field_prior" => self.field_prior = number(value, "field_prior")?,
@@ -459,6 +480,7 @@ impl GatherSettings {
                 Property::String(s) => s.clone(),
                 Property::Integer(i) => i.to_string(),
                 Property::Float(f) => f.to_string(),
+                Property::Boolean(b) => b.to_string(),
                 other => {
                     return Err((
                         property.line,
@@ -474,6 +496,28 @@ impl GatherSettings {
             .validate()
             .map_err(|message| (plugin.line, message))?;
         Ok(settings)
+    }
+
+    /// The settings for a scene whose integrator is Mitsuba's `direct` or `path`: the
+    /// defaults, with its `hide_emitters`; its other properties are listed to be warned of
+    /// (the gather chooses its own samples).
+    pub fn from_mitsuba_integrator(plugin: &Plugin) -> Result<MitsubaIntegrator, (u32, String)> {
+        let mut settings = GatherSettings::default();
+        if let Some(property) = plugin.properties.get("hide_emitters") {
+            match property.value {
+                Property::Boolean(hide) => settings.hide_emitters = hide,
+                ref other => {
+                    return Err((
+                        property.line,
+                        format!("\"hide_emitters\" cannot be a {}", other.kind()),
+                    ))
+                }
+            }
+        }
+        Ok(MitsubaIntegrator {
+            settings,
+            ignored: plugin.unknown_properties(&["hide_emitters"]),
+        })
     }
 
     /// Checks ranges and combinations.
