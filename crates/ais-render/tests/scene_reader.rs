@@ -150,12 +150,24 @@ fn ignored_properties_and_filters_are_warned_about() {
 }
 
 #[test]
+fn a_uniform_spectrum_is_its_value_in_every_channel() {
+    let scene = parse(
+        "<scene><emitter type=\"constant\"><spectrum name=\"radiance\" value=\"0.25\"/></emitter></scene>",
+    )
+    .unwrap();
+    let radiance = &scene.emitters[0].properties["radiance"].value;
+    assert_eq!(*radiance, ais_render::scene::Property::Rgb([0.25; 3]));
+}
+
+#[test]
 fn every_error_names_file_line_and_problem() {
     let cases: &[(&str, &str)] = &[
         ("<scene><shape type=\"cube\"></scene>", "malformed XML"),
         ("<world/>", "root element must be <scene>"),
         ("<scene>\n<medium type=\"homogeneous\"/></scene>", "test.xml:2: <medium> is not supported"),
         ("<scene>\n<include filename=\"x.xml\"/></scene>", "<include> is not supported"),
+        ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" value=\"400:1, 700:2\"/></emitter></scene>", "test.xml:2: a <spectrum> of wavelength:value pairs is not supported"),
+        ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" filename=\"d65.spd\"/></emitter></scene>", "test.xml:2: a <spectrum> read from a file is not supported"),
         ("<scene>\n<banana/></scene>", "test.xml:2: unexpected element <banana> in <scene>"),
         ("<scene>\n<shape/></scene>", "test.xml:2: <shape> needs a \"type\" attribute"),
         ("<scene>\n<shape type=\"teapot\"/></scene>", "test.xml:2: shape type \"teapot\" is not supported"),

@@ -21,7 +21,7 @@ const PLUGIN_TAGS: &[&str] = &[
 ];
 
 /// Tags of Mitsuba that this reader refuses with a clear error rather than ignore.
-const UNSUPPORTED_TAGS: &[&str] = &["medium", "phase", "volume", "spectrum", "include", "alias"];
+const UNSUPPORTED_TAGS: &[&str] = &["medium", "phase", "volume", "include", "alias"];
 
 /// The deepest nesting of plugins a scene may use (Mitsuba's scenes nest a handful).
 pub const DEEPEST_NESTING: usize = 64;
@@ -47,6 +47,7 @@ struct Reader<'a> {
 fn known_attributes(tag: &str) -> &'static [&'static str] {
     match tag {
         "float" | "integer" | "boolean" | "string" | "rgb" => &["name", "value"],
+        "spectrum" => &["name", "value", "filename"],
         "point" | "vector" => &["name", "value", "x", "y", "z"],
         "transform" => &["name"],
         "ref" => &["id", "name"],
@@ -323,6 +324,33 @@ impl<'a> Reader<'a> {
         Ok(plugin)
     }
 
+    /// A `<spectrum>` as Mitsuba's RGB variants read it: one value is a uniform spectrum, the
+    /// same in every channel. Wavelength–value pairs and spectrum files need the colour
+    /// matching functions, which ais does not have yet: they are refused, with the way out.
+    fn spectrum(&self, node: roxmltree::Node) -> Result<Property, InputError> {
+        if node.attribute("filename").is_some() {
+            return Err(self.error(
+                node,
+                "a <spectrum> read from a file is not supported by ais; give an <rgb>",
+            ));
+        }
+        let text = self.attribute(node, "value")?;
+        if text.contains(':') {
+            return Err(self.error(
+                node,
+                "a <spectrum> of wavelength:value pairs is not supported by ais yet; give one \
+                 value (a uniform spectrum) or an <rgb>",
+            ));
+        }
+        match self.numbers(node, &text)?.as_slice() {
+            [v] => Ok(Property::Rgb([*v; 3])),
+            _ => Err(self.error(
+                node,
+                format!("<spectrum> needs one value or wavelength:value pairs, got \"{text}\""),
+            )),
+        }
+    }
+
     fn numbers(&self, node: roxmltree::Node, text: &str) -> Result<Vec<f64>, InputError> {
         text.split(|c: char| c == ',' || c.is_whitespace())
             .filter(|s| !s.is_empty())
@@ -405,6 +433,7 @@ impl<'a> Reader<'a> {
                     }
                 }
             }
+            "spectrum" => self.spectrum(node)?,
             "point" => Property::Point(self.vector3(node, "value", 0.0)?),
             "vector" => Property::Vector(self.vector3(node, "value", 0.0)?),
             "transform" => Property::Transform(self.transform(node)?),
