@@ -204,6 +204,7 @@ pub fn default_world(width: u32, height: u32) -> World {
         emitters: Vec::new(),
         integrator: None,
         warnings: Vec::new(),
+        files: crate::scene::FileResolver::new(std::path::Path::new("."), &[]),
     };
     World {
         geometry,

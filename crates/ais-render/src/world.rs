@@ -165,7 +165,7 @@ impl World {
         let geometry = Geometry::build(inputs);
         let environment = match description.emitters.as_slice() {
             [] => None,
-            [one] => Some(environment(&file, one, &mut warnings)?),
+            [one] => Some(environment(&file, &description.files, one, &mut warnings)?),
             [_, second, ..] => {
                 return Err(InputError::at(
                     &file,
@@ -270,6 +270,7 @@ fn radiance_property(file: &Path, plugin: &Plugin, name: &str) -> Result<Vec3, I
 /// A scene-level `envmap` or `constant` emitter.
 fn environment(
     file: &Path,
+    files: &crate::scene::FileResolver,
     plugin: &Plugin,
     warnings: &mut Vec<String>,
 ) -> Result<Environment, InputError> {
@@ -291,7 +292,7 @@ fn environment(
                 .string("filename")
                 .map_err(at)?
                 .ok_or_else(|| InputError::at(file, plugin.line, "envmap needs a \"filename\""))?;
-            let path = file.parent().unwrap_or(Path::new(".")).join(name);
+            let path = files.resolve(name);
             let loaded = read_image(&path)?;
             warnings.extend(loaded.warning);
             let scale = plugin.float("scale", 1.0).map_err(at)? as f32;

@@ -197,6 +197,32 @@ fn an_xml_scene_with_an_obj_mesh_renders() {
 }
 
 #[test]
+fn path_elements_add_folders_to_search_for_files() {
+    let dir = scratch("path-element");
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    std::fs::write(
+        dir.join("meshes/quad.obj"),
+        "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let shape = r#"<path value="meshes"/>
+    <shape type="obj"><string name="filename" value="quad.obj"/></shape>"#;
+    let scene = write_scene(&dir, shape);
+    let world = World::from_description(load_scene(&scene, &[]).unwrap()).unwrap();
+    assert_eq!(world.geometry.triangle_count(), 2);
+    // Without the <path>, the file is looked for beside the scene, and the error says so.
+    let scene = write_scene(
+        &dir,
+        r#"<shape type="obj"><string name="filename" value="quad.obj"/></shape>"#,
+    );
+    let Err(error) = World::from_description(load_scene(&scene, &[]).unwrap()) else {
+        panic!("the mesh is not beside the scene");
+    };
+    assert!(error.to_string().contains("quad.obj"), "{error}");
+    std::fs::remove_dir_all(dir).unwrap();
+}
+
+#[test]
 fn a_missing_mesh_is_an_error_naming_the_file() {
     let dir = scratch("missing");
     let scene = write_scene(

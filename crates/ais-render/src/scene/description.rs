@@ -1,5 +1,6 @@
 //! The typed scene description: what the renderer needs from a Mitsuba XML file.
 
+use super::file_resolver::FileResolver;
 use super::properties::Plugin;
 use super::xml;
 use crate::error::InputError;
@@ -104,6 +105,8 @@ pub struct SceneDescription {
     pub bsdfs: Vec<Plugin>,
     /// Scene-level emitters (`envmap`, `constant`, …), carried for the lighting code.
     pub emitters: Vec<Plugin>,
+    /// Where its relative file names point (`<path>` elements, then its folder).
+    pub files: FileResolver,
     /// The integrator element, if any.
     pub integrator: Option<Plugin>,
     /// Non-fatal problems.
@@ -121,7 +124,8 @@ pub fn load_scene(
     parse_scene(path, &text, overrides)
 }
 
-/// [`load_scene`] on text already read; relative mesh paths resolve against `path`'s folder.
+/// [`load_scene`] on text already read; relative file names resolve through `<path>`
+/// elements and `path`'s folder ([`FileResolver`]).
 pub fn parse_scene(
     path: &Path,
     text: &str,
@@ -142,8 +146,9 @@ pub fn parse_scene(
         emitters: Vec::new(),
         integrator: None,
         warnings: parsed.warnings,
+        files: FileResolver::new(path, &parsed.paths),
     };
-    let folder = path.parent().unwrap_or(Path::new("."));
+    let files = scene.files.clone();
     // BSDFs first so that shapes may reference ones declared after them.
     for plugin in parsed.plugins.iter().filter(|p| p.tag == "bsdf") {
         if plugin.id.is_none() {
@@ -167,7 +172,7 @@ pub fn parse_scene(
             }
             sensor_seen = true;
         }
-        read_top_level(path, folder, plugin, &mut scene)?;
+        read_top_level(path, &files, plugin, &mut scene)?;
     }
     if !sensor_seen {
         scene.warnings.push(format!(
@@ -181,7 +186,7 @@ pub fn parse_scene(
 /// One top-level element other than a BSDF (read before the rest).
 fn read_top_level(
     path: &Path,
-    folder: &Path,
+    files: &FileResolver,
     plugin: &Plugin,
     scene: &mut SceneDescription,
 ) -> Result<(), InputError> {
@@ -190,7 +195,7 @@ fn read_top_level(
         "bsdf" | "texture" => {}
         "sensor" => read_sensor(path, plugin, scene).map_err(at)?,
         "shape" => {
-            let shape = read_shape(path, folder, plugin, scene).map_err(at)?;
+            let shape = read_shape(path, files, plugin, scene).map_err(at)?;
             scene.shapes.push(shape);
         }
         "emitter" if plugin.kind == "area" => {
@@ -347,11 +352,11 @@ fn read_film(
 
 fn read_shape(
     path: &Path,
-    folder: &Path,
+    files: &FileResolver,
     shape: &Plugin,
     scene: &mut SceneDescription,
 ) -> Result<ShapeDescription, (u32, String)> {
-    let (geometry, known) = shape_geometry(folder, shape)?;
+    let (geometry, known) = shape_geometry(files, shape)?;
     warn_unknown(path, shape, known, &mut scene.warnings);
     let attached = attachments(shape, scene)?;
     Ok(ShapeDescription {
@@ -367,7 +372,7 @@ fn read_shape(
 
 /// A shape's geometry and the property names its type knows.
 fn shape_geometry(
-    folder: &Path,
+    files: &FileResolver,
     shape: &Plugin,
 ) -> Result<(ShapeGeometry, &'static [&'static str]), (u32, String)> {
     let mesh = |format: MeshFormat| -> Result<ShapeGeometry, (u32, String)> {
@@ -376,7 +381,7 @@ fn shape_geometry(
             format!("shape \"{}\" needs a \"filename\" string", shape.kind),
         ))?;
         Ok(ShapeGeometry::Mesh {
-            path: folder.join(name),
+            path: files.resolve(name),
             format,
         })
     };

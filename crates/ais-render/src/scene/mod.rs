@@ -1,6 +1,7 @@
 //! Scene files: the Mitsuba 3 XML subset we read, and the typed description built from it.
 
 mod description;
+mod file_resolver;
 mod properties;
 mod xml;
 
@@ -9,5 +10,6 @@ pub use description::{
     load_scene, parse_scene, CameraDescription, FovAxis, MeshFormat, SceneDescription,
     ShapeDescription, ShapeGeometry,
 };
+pub use file_resolver::FileResolver;
 pub use properties::{LocatedProperty, Plugin, Property};
 pub use xml::look_at;

@@ -32,6 +32,8 @@ pub struct ParsedScene {
     pub plugins: Vec<Plugin>,
     /// Non-fatal problems, each naming the file and line.
     pub warnings: Vec<String>,
+    /// The values of `<path>` elements, in file order.
+    pub paths: Vec<String>,
 }
 
 struct Reader<'a> {
@@ -48,6 +50,7 @@ fn known_attributes(tag: &str) -> &'static [&'static str] {
     match tag {
         "float" | "integer" | "boolean" | "string" | "rgb" => &["name", "value"],
         "spectrum" => &["name", "value", "filename"],
+        "path" => &["value"],
         "point" | "vector" => &["name", "value", "x", "y", "z"],
         "transform" => &["name"],
         "ref" => &["id", "name"],
@@ -92,12 +95,16 @@ pub fn parse(
     }
     reader.read_defaults(root, overrides)?;
     let mut plugins = Vec::new();
+    let mut paths = Vec::new();
     for child in root.children().filter(|n| n.is_element()) {
         let tag = child.tag_name().name();
         if tag == "default" {
             continue;
         }
-        if PLUGIN_TAGS.contains(&tag) {
+        if tag == "path" {
+            reader.warn_unknown_attributes(child);
+            paths.push(reader.attribute(child, "value")?);
+        } else if PLUGIN_TAGS.contains(&tag) {
             plugins.push(reader.plugin(child, 1)?);
         } else if tag == "ref" {
             return Err(reader.error(child, "a <ref> at scene level refers to nothing"));
@@ -110,6 +117,7 @@ pub fn parse(
     Ok(ParsedScene {
         plugins,
         warnings: reader.warnings,
+        paths,
     })
 }
 
