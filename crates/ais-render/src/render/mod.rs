@@ -119,12 +119,23 @@ pub fn render<I: SampleIntegrator>(
     integrator: &I,
     settings: &RenderSettings,
 ) -> RenderOutput<<I::Tile as TileState>::Stats> {
+    let mut learned = integrator.new_learning();
+    render_learning(world, integrator, settings, &mut learned)
+}
+
+/// [`render`], starting from what earlier renders of the same scene learned (`learned`)
+/// and adding what this one learns: a progressive study's passes keep one field.
+pub fn render_learning<I: SampleIntegrator>(
+    world: &World,
+    integrator: &I,
+    settings: &RenderSettings,
+    learned: &mut I::Learned,
+) -> RenderOutput<<I::Tile as TileState>::Stats> {
     let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
     let rects = tiles(width, height);
     let passes = integrator.passes(settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
-    let mut learned = integrator.new_learning();
     let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(width, height);
     for (index, &samples) in passes.iter().enumerate() {
         let pass = Pass {
@@ -139,7 +150,7 @@ pub fn render<I: SampleIntegrator>(
                     image: (width, height),
                     seed: settings.seed,
                 };
-                let result = render_tile(world, integrator, &learned, pass, &tile);
+                let result = render_tile(world, integrator, learned, pass, &tile);
                 progress.inc(1);
                 result
             })

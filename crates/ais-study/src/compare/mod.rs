@@ -18,9 +18,11 @@ pub mod report;
 use crate::oracle::Oracle;
 use ais::rng::mix64;
 use ais_render::image_io::RgbImage;
-use ais_render::integrators::gather::{GatherSettings, GatherStats, Preset, Strategy};
+use ais_render::integrators::gather::{
+    GatherLearning, GatherSettings, GatherStats, Preset, Strategy,
+};
 use ais_render::integrators::Integrator;
-use ais_render::render::{render, RayCounts, RenderSettings};
+use ais_render::render::{render, render_learning, RayCounts, RenderSettings};
 use ais_render::world::World;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::Path;
@@ -75,15 +77,27 @@ impl Configuration {
         self.technique == Technique::Oracle
     }
 
-    /// Renders one pass of `spp` samples per pixel with `seed`.
-    pub fn render_pass(&self, world: &World, spp: u32, seed: u64) -> Pass {
+    /// Renders one pass of `spp` samples per pixel with `seed`, from what the run's earlier
+    /// passes learned (`learned`: the visibility field of `ais auto`), adding to it.
+    pub fn render_pass(
+        &self,
+        world: &World,
+        spp: u32,
+        seed: u64,
+        learned: &mut GatherLearning,
+    ) -> Pass {
         let settings = RenderSettings {
             samples_per_pixel: spp,
             seed,
             progress: false,
         };
         let output = match self.technique {
-            Technique::Gather => render(world, &Integrator::Gather(self.settings), &settings),
+            Technique::Gather => render_learning(
+                world,
+                &Integrator::Gather(self.settings),
+                &settings,
+                learned,
+            ),
             Technique::Oracle => render(world, &Oracle(self.settings), &settings)
                 .map_stats(|_| GatherStats::default()),
         };
@@ -278,9 +292,10 @@ fn progressive(
         curve: Vec::new(),
         ais_memory_per_thread: 0,
     };
+    let mut learned = GatherLearning::new(&configuration.settings);
     loop {
-        let output =
-            configuration.render_pass(world, pass_spp, mix64(seed ^ mix64(run.spp as u64 + 1)));
+        let pass_seed = mix64(seed ^ mix64(run.spp as u64 + 1));
+        let output = configuration.render_pass(world, pass_spp, pass_seed, &mut learned);
         for (s, p) in sum.iter_mut().zip(&output.image.pixels) {
             for c in 0..3 {
                 s[c] += p[c] as f64 * pass_spp as f64;
