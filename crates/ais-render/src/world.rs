@@ -274,7 +274,6 @@ fn environment(
     plugin: &Plugin,
     warnings: &mut Vec<String>,
 ) -> Result<Environment, InputError> {
-    let at = |(line, message): (u32, String)| InputError::at(file, line, message);
     match plugin.kind.as_str() {
         "constant" => {
             scene::warn_unknown(file, plugin, &["radiance"], warnings);
@@ -286,52 +285,59 @@ fn environment(
                 file, plugin, "radiance",
             )?))
         }
-        "envmap" => {
-            scene::warn_unknown(file, plugin, &["filename", "scale", "to_world"], warnings);
-            let name = plugin
-                .string("filename")
-                .map_err(at)?
-                .ok_or_else(|| InputError::at(file, plugin.line, "envmap needs a \"filename\""))?;
-            let path = files.resolve(name);
-            let loaded = read_image(&path)?;
-            warnings.extend(loaded.warning);
-            let scale = plugin.float("scale", 1.0).map_err(at)? as f32;
-            if !(scale.is_finite() && scale >= 0.0) {
-                return Err(InputError::at(
-                    file,
-                    plugin.line,
-                    "envmap scale must be finite and non-negative",
-                ));
-            }
-            let mut image = loaded.image;
-            for p in &mut image.pixels {
-                *p = p.map(|c| c * scale);
-            }
-            if image
-                .pixels
-                .iter()
-                .flatten()
-                .any(|&c| c > crate::image_io::LARGEST_TEXEL)
-            {
-                return Err(InputError::at(
-                    file,
-                    plugin.line,
-                    format!(
-                        "envmap scale {scale:e} makes texels exceed {:e}",
-                        crate::image_io::LARGEST_TEXEL
-                    ),
-                ));
-            }
-            let to_world = plugin.transform("to_world").map_err(at)?;
-            let rotation = DMat3::from_mat4(to_world);
-            Ok(Environment::Map(Box::new(EnvironmentMap::new(
-                image, rotation,
-            ))))
-        }
+        "envmap" => environment_map(file, files, plugin, warnings),
         other => Err(InputError::at(
             file,
             plugin.line,
             format!("emitter type \"{other}\" is not supported (envmap, constant, area)"),
         )),
     }
+}
+
+/// A scene-level `envmap`: the image found through `files`, scaled and rotated.
+fn environment_map(
+    file: &Path,
+    files: &crate::scene::FileResolver,
+    plugin: &Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<Environment, InputError> {
+    let at = |(line, message): (u32, String)| InputError::at(file, line, message);
+    scene::warn_unknown(file, plugin, &["filename", "scale", "to_world"], warnings);
+    let name = plugin
+        .string("filename")
+        .map_err(at)?
+        .ok_or_else(|| InputError::at(file, plugin.line, "envmap needs a \"filename\""))?;
+    let loaded = read_image(&files.resolve(name))?;
+    warnings.extend(loaded.warning);
+    let scale = plugin.float("scale", 1.0).map_err(at)? as f32;
+    if !(scale.is_finite() && scale >= 0.0) {
+        return Err(InputError::at(
+            file,
+            plugin.line,
+            "envmap scale must be finite and non-negative",
+        ));
+    }
+    let mut image = loaded.image;
+    for p in &mut image.pixels {
+        *p = p.map(|c| c * scale);
+    }
+    if image
+        .pixels
+        .iter()
+        .flatten()
+        .any(|&c| c > crate::image_io::LARGEST_TEXEL)
+    {
+        return Err(InputError::at(
+            file,
+            plugin.line,
+            format!(
+                "envmap scale {scale:e} makes texels exceed {:e}",
+                crate::image_io::LARGEST_TEXEL
+            ),
+        ));
+    }
+    let rotation = DMat3::from_mat4(plugin.transform("to_world").map_err(at)?);
+    Ok(Environment::Map(Box::new(EnvironmentMap::new(
+        image, rotation,
+    ))))
 }
