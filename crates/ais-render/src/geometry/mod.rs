@@ -10,7 +10,7 @@ pub use primitive::{Primitive, Sphere, Triangle};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
 
 use crate::mesh::TriangleMesh;
-use glam::{Vec2, Vec3, Vec3A};
+use glam::{Vec2, Vec3};
 use obvhs::cwbvh::CwBvh;
 use std::time::{Duration, Instant};
 
@@ -178,15 +178,6 @@ impl Geometry {
         self.build_time
     }
 
-    fn bvh_ray(ray: &Ray) -> obvhs::ray::Ray {
-        obvhs::ray::Ray::new(
-            Vec3A::from(ray.origin),
-            Vec3A::from(ray.direction),
-            0.0,
-            ray.t_max,
-        )
-    }
-
     #[inline]
     fn intersect_primitive(&self, index: usize, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
         match &self.primitives[index] {
@@ -200,7 +191,7 @@ impl Geometry {
         let bvh = self.bvh.as_ref()?;
         let mut best: Option<(usize, f32, Vec2)> = None;
         let mut hit = obvhs::ray::RayHit::none();
-        bvh.ray_traverse(Self::bvh_ray(ray), &mut hit, |r, id| {
+        bvh.ray_traverse(ray.to_bvh(ray.t_max), &mut hit, |r, id| {
             match self.intersect_primitive(id, ray, r.tmax) {
                 Some((t, barycentrics)) => {
                     best = Some((id, t, barycentrics));
@@ -229,7 +220,7 @@ impl Geometry {
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
-        !bvh.ray_traverse_miss(Self::bvh_ray(ray), |r, id| {
+        !bvh.ray_traverse_miss(ray.to_bvh(ray.t_max), |r, id| {
             self.intersect_primitive(id, ray, r.tmax)
                 .map_or(f32::INFINITY, |(t, _)| t)
         })

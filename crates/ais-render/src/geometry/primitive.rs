@@ -91,13 +91,17 @@ impl Sphere {
     }
 }
 
+impl obvhs::Boundable for Triangle {
+    fn aabb(&self) -> obvhs::aabb::Aabb {
+        let [a, b, c] = self.vertices.map(glam::Vec3A::from);
+        obvhs::aabb::Aabb::new(a.min(b).min(c), a.max(b).max(c))
+    }
+}
+
 impl obvhs::Boundable for Primitive {
     fn aabb(&self) -> obvhs::aabb::Aabb {
         match self {
-            Primitive::Triangle(t) => {
-                let [a, b, c] = t.vertices.map(glam::Vec3A::from);
-                obvhs::aabb::Aabb::new(a.min(b).min(c), a.max(b).max(c))
-            }
+            Primitive::Triangle(t) => t.aabb(),
             Primitive::Sphere(s) => {
                 let c = glam::Vec3A::from(s.center);
                 let r = glam::Vec3A::splat(s.radius);

@@ -14,6 +14,16 @@ pub struct Ray {
 }
 
 impl Ray {
+    /// The same ray for obvhs's traversal, ending at `t_max`.
+    pub fn to_bvh(&self, t_max: f32) -> obvhs::ray::Ray {
+        obvhs::ray::Ray::new(
+            glam::Vec3A::from(self.origin),
+            glam::Vec3A::from(self.direction),
+            0.0,
+            t_max,
+        )
+    }
+
     /// An unbounded ray.
     pub fn new(origin: Vec3, direction: Vec3) -> Self {
         Ray {

@@ -8,7 +8,7 @@
 
 use crate::geometry::{Ray, Triangle};
 use ais::sampling::AliasTable;
-use glam::{Vec3, Vec3A};
+use glam::Vec3;
 use obvhs::cwbvh::CwBvh;
 use std::time::Duration;
 
@@ -24,22 +24,11 @@ pub struct MeshEmitter {
     bvh: CwBvh,
 }
 
-/// Bounds of one triangle, for the BVH build.
-struct Bounded<'a>(&'a Triangle);
-
-impl obvhs::Boundable for Bounded<'_> {
-    fn aabb(&self) -> obvhs::aabb::Aabb {
-        let [a, b, c] = self.0.vertices.map(Vec3A::from);
-        obvhs::aabb::Aabb::new(a.min(b).min(c), a.max(b).max(c))
-    }
-}
-
 impl MeshEmitter {
     /// The mesh of `triangles` (at least one).
     pub fn new(triangles: Vec<Triangle>) -> Self {
-        let bounded: Vec<Bounded> = triangles.iter().map(Bounded).collect();
         let bvh = obvhs::cwbvh::builder::build_cwbvh(
-            &bounded,
+            &triangles,
             obvhs::BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
@@ -91,7 +80,7 @@ impl MeshEmitter {
         let ray = Ray::new(point, direction);
         let mut density = 0.0;
         self.bvh.ray_traverse(
-            Self::bvh_ray(&ray, f32::INFINITY),
+            ray.to_bvh(f32::INFINITY),
             &mut obvhs::ray::RayHit::none(),
             |_, id| {
                 let triangle = &self.triangles[id];
@@ -113,26 +102,16 @@ impl MeshEmitter {
     pub fn intersect(&self, ray: &Ray) -> Option<(f32, Vec3)> {
         let mut hit = obvhs::ray::RayHit::none();
         let mut nearest: Option<(f32, usize)> = None;
-        self.bvh.ray_traverse(
-            Self::bvh_ray(ray, ray.t_max),
-            &mut hit,
-            |r, id| match self.triangles[id].intersect(ray, r.tmax) {
-                Some((t, _)) => {
-                    nearest = Some((t, id));
-                    t
+        self.bvh
+            .ray_traverse(ray.to_bvh(ray.t_max), &mut hit, |r, id| {
+                match self.triangles[id].intersect(ray, r.tmax) {
+                    Some((t, _)) => {
+                        nearest = Some((t, id));
+                        t
+                    }
+                    None => f32::INFINITY,
                 }
-                None => f32::INFINITY,
-            },
-        );
+            });
         nearest.map(|(t, id)| (t, self.triangles[id].normal().normalize()))
-    }
-
-    fn bvh_ray(ray: &Ray, t_max: f32) -> obvhs::ray::Ray {
-        obvhs::ray::Ray::new(
-            Vec3A::from(ray.origin),
-            Vec3A::from(ray.direction),
-            0.0,
-            t_max,
-        )
     }
 }
