@@ -179,15 +179,11 @@ pub fn run(args: CompareArgs) -> Result<(), String> {
     check_arguments(&args)?;
     let world = load_world(&SceneRequest {
         scene: args.scene.as_deref(),
-        defines: &args.scene_flags.define,
+        flags: &args.scene_flags,
         resolution: args.resolution,
         default_resolution: (320, 180),
-        strict: args.scene_flags.strict,
     })?;
-    let base = args.gather.settings(
-        &world.description.file,
-        world.description.integrator.as_ref(),
-    )?;
+    let base = args.gather.settings(&world, args.scene_flags.strict)?;
     let pixel = figure_pixel(&args, world.resolution)?;
     let key = reference_key(&args, world.resolution, base.rays)?;
     let settings = StudySettings {

@@ -4,8 +4,8 @@
 
 use ais_render::integrators::gather::settings::PARAMETERS;
 use ais_render::integrators::gather::GatherSettings;
-use ais_render::scene::Plugin;
-use std::path::Path;
+use ais_render::request::{gather_settings, ParameterOverride};
+use ais_render::world::World;
 
 /// The gather's parameters as flags (None: not given).
 #[derive(clap::Args, Clone, Default)]
@@ -103,41 +103,28 @@ impl GatherFlags {
         value.as_deref()
     }
 
-    /// Gather settings: defaults, then the scene's `<integrator type="gather">` properties
-    /// (`plugin`, read from `file`), then these flags.
-    pub fn settings(&self, file: &Path, plugin: Option<&Plugin>) -> Result<GatherSettings, String> {
-        let at = |(line, message): (u32, String)| format!("{}:{line}: {message}", file.display());
-        let mut settings = match plugin {
-            Some(plugin) if plugin.kind == "gather" => {
-                GatherSettings::from_properties(plugin).map_err(at)?
-            }
-            Some(plugin) if plugin.kind == "direct" || plugin.kind == "path" => {
-                let read = GatherSettings::from_mitsuba_integrator(plugin).map_err(at)?;
-                for (name, line) in read.ignored {
-                    eprintln!(
-                        "warning: {}:{line}: \"{name}\" of integrator \"{}\" is ignored (the gather takes --rays and --strategy)",
-                        file.display(),
-                        plugin.kind
-                    );
-                }
-                read.settings
-            }
-            _ => GatherSettings::default(),
-        };
-        self.apply(&mut settings)?;
+    /// Gather settings: defaults, then the scene's `<integrator>` (gather, or Mitsuba's direct
+    /// and path), then these flags; warnings about the scene's integrator are printed (and
+    /// refused with `strict`).
+    pub fn settings(&self, world: &World, strict: bool) -> Result<GatherSettings, String> {
+        let overrides: Vec<ParameterOverride> = PARAMETERS
+            .iter()
+            .filter_map(|&name| {
+                self.get(name).map(|value| ParameterOverride {
+                    name,
+                    value: value.to_string(),
+                })
+            })
+            .collect();
+        let mut warnings = Vec::new();
+        let settings = gather_settings(
+            world,
+            &overrides,
+            |name| format!("--{}", name.replace('_', "-")),
+            &mut warnings,
+        )?;
+        crate::report_warnings(&warnings, strict)?;
         Ok(settings)
-    }
-
-    /// Overrides `settings` with the flags given, and checks the result.
-    pub fn apply(&self, settings: &mut GatherSettings) -> Result<(), String> {
-        for name in PARAMETERS {
-            if let Some(value) = self.get(name) {
-                settings
-                    .set(name, value)
-                    .map_err(|message| format!("--{}: {message}", name.replace('_', "-")))?;
-            }
-        }
-        settings.validate()
     }
 }
 

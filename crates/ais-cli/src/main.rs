@@ -1,7 +1,6 @@
 //! The `ais` command.
 
-use ais_render::default_scene::default_world;
-use ais_render::scene::load_scene;
+use ais_render::request::SceneSource;
 use ais_render::world::World;
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -88,50 +87,42 @@ struct SceneFlags {
 struct SceneRequest<'a> {
     /// The scene file, or None for the built-in default scene.
     scene: Option<&'a std::path::Path>,
-    /// `-D name=value` parameters.
-    defines: &'a [(String, String)],
+    /// `-D name=value` parameters and `--strict`.
+    flags: &'a SceneFlags,
     /// `--resolution`, if given.
     resolution: Option<(u32, u32)>,
     /// The built-in scene's size without `--resolution`.
     default_resolution: (u32, u32),
-    /// Whether warnings are errors (`--strict`).
-    strict: bool,
 }
 
 /// The scene file's world (resolution overridden if given), or the built-in default scene;
 /// prints the scene's warnings, or refuses the scene for them with `--strict`.
 fn load_world(request: &SceneRequest) -> Result<World, String> {
-    let world = match request.scene {
-        Some(path) => {
-            let mut description = load_scene(path, request.defines).map_err(|e| e.to_string())?;
-            if let Some(resolution) = request.resolution {
-                description.resolution = resolution;
-            }
-            ais_render::limits::check_image_memory(description.resolution)?;
-            World::from_description(description).map_err(|e| e.to_string())?
-        }
-        None => {
-            let (width, height) = request.resolution.unwrap_or(request.default_resolution);
-            ais_render::limits::check_image_memory((width, height))?;
-            let mut world = default_world(width, height);
-            world
-                .warnings
-                .extend(request.defines.iter().map(|(name, value)| {
-                    format!("-D {name}={value} is not used: the built-in scene has no parameters")
-                }));
-            world
-        }
-    };
-    for warning in &world.warnings {
+    let world = ais_render::request::load_world(&ais_render::request::SceneRequest {
+        source: match request.scene {
+            Some(path) => SceneSource::File(path),
+            None => SceneSource::BuiltIn,
+        },
+        defines: &request.flags.define,
+        resolution: request.resolution,
+        default_resolution: request.default_resolution,
+    })?;
+    report_warnings(&world.warnings, request.flags.strict)?;
+    Ok(world)
+}
+
+/// Prints warnings about the input; with `--strict` (`strict`), any warning is an error.
+fn report_warnings(warnings: &[String], strict: bool) -> Result<(), String> {
+    for warning in warnings {
         eprintln!("warning: {warning}");
     }
-    if request.strict && !world.warnings.is_empty() {
+    if strict && !warnings.is_empty() {
         return Err(format!(
             "{} warning(s) above, and --strict makes them errors",
-            world.warnings.len()
+            warnings.len()
         ));
     }
-    Ok(world)
+    Ok(())
 }
 
 fn main() -> ExitCode {

@@ -6,7 +6,7 @@ use ais_render::atomic_write::OutputSet;
 use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
 use ais_render::integrators::gather::GatherStats;
 use ais_render::integrators::{AmbientOcclusion, Integrator};
-use ais_render::render::{render, RenderOutput, RenderSettings};
+use ais_render::render::{render, PixelRect, RenderOutput, RenderSettings};
 use ais_render::world::World;
 use ais_study::oracle::Oracle;
 use ais_study::timing::{TimedGather, SAMPLING};
@@ -40,7 +40,7 @@ pub struct RenderArgs {
     /// Override the film size, e.g. 640x360.
     #[arg(long, value_parser = parse_resolution)]
     resolution: Option<(u32, u32)>,
-    /// What to render (default: the scene's `<integrator type="gather">`, else gather).
+    /// What to render (default: the gather, with the scene's `<integrator>` settings).
     #[arg(long, value_enum)]
     integrator: Option<IntegratorChoice>,
     #[command(flatten)]
@@ -67,6 +67,10 @@ pub struct RenderArgs {
     /// Base random seed.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Render only the pixels x..x+w, y..y+h of the image, written as a w×h image: tiles
+    /// rendered apart and pasted together equal the whole render (see docs/cli.md).
+    #[arg(long, value_parser = parse_crop)]
+    crop: Option<[usize; 4]>,
     /// Skip the PNG preview.
     #[arg(long)]
     no_preview: bool,
@@ -83,34 +87,11 @@ struct Rendered {
     ais_time: Option<Duration>,
 }
 
-/// The integrator: the flag, else the scene's, else the gather.
-fn integrator_choice(args: &RenderArgs, world: &World) -> Result<IntegratorChoice, String> {
-    let file = world.description.file.display();
-    Ok(match (args.integrator, &world.description.integrator) {
-        (Some(choice), _) => choice,
-        (None, Some(plugin)) if plugin.kind == "gather" => IntegratorChoice::Gather,
-        (None, Some(plugin)) if plugin.kind == "direct" || plugin.kind == "path" => {
-            eprintln!(
-                "warning: {file}:{}: integrator \"{}\" rendered with ais's gather (MIS, direct light only)",
-                plugin.line, plugin.kind
-            );
-            IntegratorChoice::Gather
-        }
-        (None, Some(plugin)) => {
-            return Err(format!(
-                "{file}:{}: integrator \"{}\" is not supported (gather, direct)",
-                plugin.line, plugin.kind
-            ))
-        }
-        (None, None) => IntegratorChoice::Gather,
-    })
-}
-
+/// The integrator: the flag, else the gather (which reads the scene's `<integrator>`).
 fn integrator(args: &RenderArgs, world: &World) -> Result<Integrator, String> {
-    Ok(match integrator_choice(args, world)? {
+    Ok(match args.integrator.unwrap_or(IntegratorChoice::Gather) {
         IntegratorChoice::Gather => {
-            let plugin = world.description.integrator.as_ref();
-            Integrator::Gather(args.gather.settings(&world.description.file, plugin)?)
+            Integrator::Gather(args.gather.settings(world, args.scene_flags.strict)?)
         }
         IntegratorChoice::Normals => Integrator::Normals,
         IntegratorChoice::Ao => {
@@ -160,6 +141,18 @@ fn run_integrator(
             ais_time: None,
         }),
     }
+}
+
+/// Parses `--crop x,y,w,h`.
+fn parse_crop(text: &str) -> Result<[usize; 4], String> {
+    let numbers: Vec<usize> = text
+        .split(',')
+        .map(|part| part.trim().parse::<usize>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("\"{text}\" is not x,y,w,h (four whole numbers)"))?;
+    numbers
+        .try_into()
+        .map_err(|_| format!("\"{text}\" is not x,y,w,h (four whole numbers)"))
 }
 
 /// Checks, before any work, that the outputs can be written: an `.exr` path in an existing
@@ -214,11 +207,7 @@ fn same_file(a: &Path, b: &Path) -> bool {
 }
 
 /// Writes the image, the AOV and the preview as a unit: all of them, or none.
-fn write_outputs(
-    args: &RenderArgs,
-    world: &World,
-    output: &RenderOutput<GatherStats>,
-) -> Result<(), String> {
+fn write_outputs(args: &RenderArgs, output: &RenderOutput<GatherStats>) -> Result<(), String> {
     let mut outputs = OutputSet::default();
     let failed = |e: WriteError| e.to_string();
     outputs
@@ -227,10 +216,9 @@ fn write_outputs(
         })
         .map_err(failed)?;
     if let Some(path) = &args.aov_traced {
-        let (width, height) = world.resolution;
         let aov = RgbImage {
-            width: width as usize,
-            height: height as usize,
+            width: output.image.width,
+            height: output.image.height,
             pixels: output.work_per_sample.iter().map(|&t| [t; 3]).collect(),
         };
         outputs
@@ -254,23 +242,29 @@ pub fn run(args: RenderArgs) -> Result<(), String> {
     check_outputs(&args)?;
     let world = load_world(&SceneRequest {
         scene: args.scene.as_deref(),
-        defines: &args.scene_flags.define,
+        flags: &args.scene_flags,
         resolution: args.resolution,
         default_resolution: (640, 360),
-        strict: args.scene_flags.strict,
     })?;
     let integrator = integrator(&args, &world)?;
     let samples_per_pixel = args.spp.unwrap_or(world.sample_count);
     if samples_per_pixel == 0 {
         return Err("--spp must be at least 1".into());
     }
+    let (width, height) = world.resolution;
+    let crop = args
+        .crop
+        .map(|crop| PixelRect::check_crop(crop, (width as usize, height as usize)))
+        .transpose()
+        .map_err(|message| format!("--crop: {message}"))?;
     let settings = RenderSettings {
         samples_per_pixel,
         seed: args.seed,
         progress: !args.quiet && std::io::stderr().is_terminal(),
+        crop,
     };
     let rendered = run_integrator(&args, &world, &integrator, &settings)?;
-    write_outputs(&args, &world, &rendered.output)?;
+    write_outputs(&args, &rendered.output)?;
     print_summary(&args, &world, &integrator, &rendered, samples_per_pixel);
     Ok(())
 }
@@ -290,6 +284,9 @@ fn print_summary(
         "resolution   {width}×{height}, {samples_per_pixel} spp, {} threads",
         rayon::current_num_threads()
     );
+    if let Some([x, y, w, h]) = args.crop {
+        println!("crop         {w}×{h} pixels from ({x}, {y})");
+    }
     println!(
         "triangles    {} ({} primitives)",
         world.geometry.triangle_count(),

@@ -20,6 +20,7 @@ pub mod lights;
 pub mod limits;
 pub mod mesh;
 pub mod render;
+pub mod request;
 pub mod scene;
 pub mod shapes;
 pub mod world;

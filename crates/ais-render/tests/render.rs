@@ -5,7 +5,7 @@ use ais_render::default_scene::default_world;
 use ais_render::integrators::gather::{self, GatherStats};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Sharing};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
-use ais_render::render::{render, RenderOutput, RenderSettings};
+use ais_render::render::{render, PixelRect, RenderOutput, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
 use std::path::{Path, PathBuf};
@@ -18,6 +18,7 @@ fn settings(spp: u32) -> RenderSettings {
         samples_per_pixel: spp,
         seed: 5,
         progress: false,
+        crop: None,
     }
 }
 
@@ -74,6 +75,56 @@ fn images_are_bit_identical_at_one_and_two_threads() {
         bits(&per_batch.image),
         "the guide changes the proposal"
     );
+}
+
+/// Renders `crops` of `world` with `integrator` and pastes them into a whole image.
+fn pasted_crops(world: &World, integrator: &Integrator, crops: &[[usize; 4]]) -> Vec<u32> {
+    let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
+    let mut pasted = vec![[f32::NAN; 3]; width * height];
+    for &crop in crops {
+        let rect = PixelRect::check_crop(crop, (width, height)).unwrap();
+        let part = render(
+            world,
+            integrator,
+            &RenderSettings {
+                crop: Some(rect),
+                ..settings(2)
+            },
+        );
+        assert_eq!((part.image.width, part.image.height), (crop[2], crop[3]));
+        for (i, (x, y)) in rect.pixels().enumerate() {
+            pasted[y * width + x] = part.image.pixels[i];
+        }
+    }
+    pasted.iter().flatten().map(|c| c.to_bits()).collect()
+}
+
+#[test]
+fn crops_pasted_together_equal_the_whole_render() {
+    let world = default_world(48, 27);
+    // Pixels that are rendered independently agree for any split...
+    let uneven = [[0, 0, 17, 27], [17, 0, 31, 10], [17, 10, 31, 17]];
+    // ...and tiles that share state (neighbouring gathers' maps) for splits on the tile grid.
+    let on_the_grid = [[0, 0, 16, 27], [16, 0, 32, 16], [16, 16, 32, 11]];
+    let shared_pass = GatherSettings {
+        sharing: Sharing::LearningPass { stride: 4 },
+        ..GatherSettings::preset(Preset::Shared)
+    };
+    let cases = [
+        (GatherSettings::preset(Preset::Off), &uneven),
+        (GatherSettings::preset(Preset::Conservative), &uneven),
+        (GatherSettings::preset(Preset::Shared), &on_the_grid),
+        (shared_pass, &on_the_grid),
+    ];
+    for (gather, crops) in cases {
+        let integrator = Integrator::Gather(gather);
+        let whole = render(&world, &integrator, &settings(2));
+        assert_eq!(
+            pasted_crops(&world, &integrator, crops),
+            bits(&whole.image),
+            "{gather:?}"
+        );
+    }
 }
 
 #[test]

@@ -37,6 +37,7 @@ fn shipped_scenes_load_and_render() {
                 samples_per_pixel: 1,
                 seed: 0,
                 progress: false,
+                crop: None,
             },
         );
         let mean: f64 = output.image.pixels.iter().map(|p| p[1] as f64).sum::<f64>()

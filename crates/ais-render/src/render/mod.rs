@@ -33,6 +33,11 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Show a progress bar on stderr (it also hides itself when stderr is not a terminal).
     pub progress: bool,
+    /// Render only these pixels of the image (None: all of them). The image returned is the
+    /// crop's size. Pixels keep their seeds and tiles keep their place in the whole image's
+    /// grid, so a crop's pixels equal the whole render's wherever pixels are rendered
+    /// independently (see [`PixelRect::check_crop`]).
+    pub crop: Option<PixelRect>,
 }
 
 /// A finished render.
@@ -132,11 +137,15 @@ pub fn render_learning<I: SampleIntegrator>(
     learned: &mut I::Learned,
 ) -> RenderOutput<<I::Tile as TileState>::Stats> {
     let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
-    let rects = tiles(width, height);
+    let region = settings.crop.unwrap_or(PixelRect::whole(width, height));
+    let rects: Vec<PixelRect> = tiles(width, height)
+        .iter()
+        .filter_map(|tile| tile.intersection(&region))
+        .collect();
     let passes = integrator.passes(settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
-    let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(width, height);
+    let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(region);
     for (index, &samples) in passes.iter().enumerate() {
         let pass = Pass {
             index: index as u64,
@@ -169,23 +178,23 @@ pub fn render_learning<I: SampleIntegrator>(
     }
 }
 
-/// The passes' results so far.
+/// The passes' results so far, over the rendered region.
 struct Accumulated<S> {
     film: Film,
     rays: RayCounts,
     stats: S,
     work_per_sample: Vec<f32>,
-    width: usize,
+    region: PixelRect,
 }
 
 impl<S: TileStats> Accumulated<S> {
-    fn new(width: usize, height: usize) -> Self {
+    fn new(region: PixelRect) -> Self {
         Accumulated {
-            film: Film::new(width, height),
+            film: Film::new(region.width(), region.height()),
             rays: RayCounts::default(),
             stats: S::default(),
-            work_per_sample: vec![0.0; width * height],
-            width,
+            work_per_sample: vec![0.0; region.area()],
+            region,
         }
     }
 
@@ -196,9 +205,10 @@ impl<S: TileStats> Accumulated<S> {
         let rect = result.rect;
         let share = samples as f32 / spp.max(1) as f32;
         for (i, (value, work)) in result.pixels.into_iter().zip(result.work).enumerate() {
-            let (x, y) = (rect.x0 + i % rect.width(), rect.y0 + i / rect.width());
+            let x = rect.x0 + i % rect.width() - self.region.x0;
+            let y = rect.y0 + i / rect.width() - self.region.y0;
             self.film.add_weighted(x, y, value, samples as f64);
-            let slot = &mut self.work_per_sample[y * self.width + x];
+            let slot = &mut self.work_per_sample[y * self.region.width() + x];
             *slot = if samples == spp {
                 work
             } else {

@@ -25,9 +25,56 @@ impl PixelRect {
         self.x1 - self.x0
     }
 
+    /// Rows covered.
+    pub fn height(&self) -> usize {
+        self.y1 - self.y0
+    }
+
     /// Pixels covered.
     pub fn area(&self) -> usize {
-        self.width() * (self.y1 - self.y0)
+        self.width() * self.height()
+    }
+
+    /// All pixels of a `width × height` image.
+    pub fn whole(width: usize, height: usize) -> Self {
+        PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: width,
+            y1: height,
+        }
+    }
+
+    /// The pixels in both rectangles, if any.
+    pub fn intersection(&self, other: &PixelRect) -> Option<PixelRect> {
+        let rect = PixelRect {
+            x0: self.x0.max(other.x0),
+            y0: self.y0.max(other.y0),
+            x1: self.x1.min(other.x1),
+            y1: self.y1.min(other.y1),
+        };
+        (rect.x0 < rect.x1 && rect.y0 < rect.y1).then_some(rect)
+    }
+
+    /// A crop `(x, y, w, h)` of a `width × height` image, checked: not empty, and inside.
+    pub fn check_crop(
+        [x, y, w, h]: [usize; 4],
+        (width, height): (usize, usize),
+    ) -> Result<PixelRect, String> {
+        if w == 0 || h == 0 {
+            return Err(format!("crop {x},{y},{w},{h} is empty"));
+        }
+        if x.saturating_add(w) > width || y.saturating_add(h) > height {
+            return Err(format!(
+                "crop {x},{y},{w},{h} reaches outside the {width}×{height} image"
+            ));
+        }
+        Ok(PixelRect {
+            x0: x,
+            y0: y,
+            x1: x + w,
+            y1: y + h,
+        })
     }
 
     /// Its pixels, row by row.

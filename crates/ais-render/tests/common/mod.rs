@@ -179,6 +179,7 @@ pub fn pixel_statistics<I: SampleIntegrator>(
             samples_per_pixel: spp,
             seed: 1000 + seed,
             progress: false,
+            crop: None,
         };
         let output = render(world, integrator, &settings);
         for (i, p) in output.image.pixels.iter().enumerate() {

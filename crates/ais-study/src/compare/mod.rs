@@ -90,6 +90,7 @@ impl Configuration {
             samples_per_pixel: spp,
             seed,
             progress: false,
+            crop: None,
         };
         let output = match self.technique {
             Technique::Gather => render_learning(

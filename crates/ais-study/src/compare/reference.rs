@@ -84,6 +84,7 @@ fn render_half(
                 samples_per_pixel: chunk,
                 seed: seed + done as u64,
                 progress: false,
+                crop: None,
             },
         );
         for (s, p) in sum.iter_mut().zip(&output.image.pixels) {

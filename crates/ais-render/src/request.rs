@@ -1,0 +1,131 @@
+//! What a front end asks to render, turned into a world and gather settings: the part of
+//! scene loading that the `ais` command and the Python package share.
+
+use crate::default_scene::default_world;
+use crate::integrators::gather::settings::PARAMETERS;
+use crate::integrators::gather::GatherSettings;
+use crate::scene::{load_scene, parse_scene};
+use crate::world::World;
+use std::path::Path;
+
+/// Where a scene comes from.
+#[derive(Clone, Copy, Debug)]
+pub enum SceneSource<'a> {
+    /// A Mitsuba 3 XML file.
+    File(&'a Path),
+    /// Mitsuba 3 XML text; `name` stands for the file in messages and its folder is where
+    /// relative file names point.
+    Text {
+        /// The XML.
+        text: &'a str,
+        /// What messages call it.
+        name: &'a Path,
+    },
+    /// The built-in default scene.
+    BuiltIn,
+}
+
+/// A scene to load, with the overrides a user gave.
+#[derive(Clone, Copy, Debug)]
+pub struct SceneRequest<'a> {
+    /// The scene.
+    pub source: SceneSource<'a>,
+    /// `$name` parameters of the scene file.
+    pub defines: &'a [(String, String)],
+    /// The film size, if it overrides the scene's.
+    pub resolution: Option<(u32, u32)>,
+    /// The built-in scene's size when `resolution` is not given.
+    pub default_resolution: (u32, u32),
+}
+
+/// The world a request names (its resolution overridden if asked), with the scene's
+/// warnings in [`World::warnings`]; memory is checked before geometry is built.
+pub fn load_world(request: &SceneRequest) -> Result<World, String> {
+    let description = match request.source {
+        SceneSource::File(path) => load_scene(path, request.defines),
+        SceneSource::Text { text, name } => parse_scene(name, text, request.defines),
+        SceneSource::BuiltIn => {
+            let (width, height) = request.resolution.unwrap_or(request.default_resolution);
+            crate::limits::check_image_memory((width, height))?;
+            let mut world = default_world(width, height);
+            world
+                .warnings
+                .extend(request.defines.iter().map(|(name, value)| {
+                    format!("{name}={value} is not used: the built-in scene has no parameters")
+                }));
+            return Ok(world);
+        }
+    };
+    let mut description = description.map_err(|e| e.to_string())?;
+    if let Some(resolution) = request.resolution {
+        description.resolution = resolution;
+    }
+    crate::limits::check_image_memory(description.resolution)?;
+    World::from_description(description).map_err(|e| e.to_string())
+}
+
+/// A gather parameter given by the user, named as in the parameter table (`rays`,
+/// `ais`, …).
+#[derive(Clone, Debug)]
+pub struct ParameterOverride<'a> {
+    /// The parameter's name.
+    pub name: &'a str,
+    /// Its value, as text.
+    pub value: String,
+}
+
+/// The gather's settings for `world`: the defaults, then its scene's `<integrator>` (gather,
+/// or Mitsuba's direct and path), then `overrides`. Scene properties the gather does not
+/// use are added to `warnings`; an override's error names it through `spell` (e.g. as a
+/// flag, `--map-res`).
+pub fn gather_settings(
+    world: &World,
+    overrides: &[ParameterOverride],
+    spell: impl Fn(&str) -> String,
+    warnings: &mut Vec<String>,
+) -> Result<GatherSettings, String> {
+    let file = world.description.file.display();
+    let at = |(line, message): (u32, String)| format!("{file}:{line}: {message}");
+    let mut settings = match &world.description.integrator {
+        Some(plugin) if plugin.kind == "gather" => {
+            GatherSettings::from_properties(plugin).map_err(at)?
+        }
+        Some(plugin) if plugin.kind == "direct" || plugin.kind == "path" => {
+            warnings.push(format!(
+                "{file}:{}: integrator \"{}\" rendered with ais's gather (MIS, direct light only)",
+                plugin.line, plugin.kind
+            ));
+            let read = GatherSettings::from_mitsuba_integrator(plugin).map_err(at)?;
+            warnings.extend(read.ignored.into_iter().map(|(name, line)| {
+                format!(
+                    "{file}:{line}: \"{name}\" of integrator \"{}\" is ignored (the gather takes rays and strategy)",
+                    plugin.kind
+                )
+            }));
+            read.settings
+        }
+        Some(plugin) => {
+            return Err(format!(
+                "{file}:{}: integrator \"{}\" is not supported (gather, direct, path)",
+                plugin.line, plugin.kind
+            ))
+        }
+        None => GatherSettings::default(),
+    };
+    if let Some(unknown) = overrides.iter().find(|o| !PARAMETERS.contains(&o.name)) {
+        return Err(format!(
+            "unknown gather parameter \"{}\" (known: {})",
+            unknown.name,
+            PARAMETERS.join(", ")
+        ));
+    }
+    for name in PARAMETERS {
+        for given in overrides.iter().filter(|o| o.name == name) {
+            settings
+                .set(name, &given.value)
+                .map_err(|message| format!("{}: {message}", spell(name)))?;
+        }
+    }
+    settings.validate()?;
+    Ok(settings)
+}
