@@ -106,7 +106,8 @@ fn load_world(request: &SceneRequest) -> Result<World, String> {
         defines: &request.flags.define,
         resolution: request.resolution,
         default_resolution: request.default_resolution,
-    })?;
+    })
+    .map_err(|e| e.to_string())?;
     report_warnings(&world.warnings, request.flags.strict)?;
     Ok(world)
 }

@@ -195,7 +195,7 @@ pub fn default_world(width: u32, height: u32) -> World {
     ];
     let camera_description = default_camera();
     let description = SceneDescription {
-        file: "<built-in default scene>".into(),
+        file: crate::request::BUILT_IN_NAME.into(),
         camera: camera_description.clone(),
         resolution: (width, height),
         sample_count: 4,

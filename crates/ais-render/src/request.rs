@@ -2,6 +2,7 @@
 //! scene loading that the `ais` command and the Python package share.
 
 use crate::default_scene::default_world;
+use crate::error::InputError;
 use crate::integrators::gather::settings::PARAMETERS;
 use crate::integrators::gather::GatherSettings;
 use crate::scene::{load_scene, parse_scene};
@@ -38,15 +39,20 @@ pub struct SceneRequest<'a> {
     pub default_resolution: (u32, u32),
 }
 
+/// What messages call the built-in default scene.
+pub const BUILT_IN_NAME: &str = "<built-in default scene>";
+
 /// The world a request names (its resolution overridden if asked), with the scene's
-/// warnings in [`World::warnings`]; memory is checked before geometry is built.
-pub fn load_world(request: &SceneRequest) -> Result<World, String> {
+/// warnings in [`World::warnings`]; memory is checked before geometry is built. An error
+/// names the file and, where known, the line.
+pub fn load_world(request: &SceneRequest) -> Result<World, InputError> {
     let description = match request.source {
         SceneSource::File(path) => load_scene(path, request.defines),
         SceneSource::Text { text, name } => parse_scene(name, text, request.defines),
         SceneSource::BuiltIn => {
             let (width, height) = request.resolution.unwrap_or(request.default_resolution);
-            crate::limits::check_image_memory((width, height))?;
+            crate::limits::check_image_memory((width, height))
+                .map_err(|message| InputError::new(BUILT_IN_NAME, message))?;
             let mut world = default_world(width, height);
             world
                 .warnings
@@ -56,12 +62,13 @@ pub fn load_world(request: &SceneRequest) -> Result<World, String> {
             return Ok(world);
         }
     };
-    let mut description = description.map_err(|e| e.to_string())?;
+    let mut description = description?;
     if let Some(resolution) = request.resolution {
         description.resolution = resolution;
     }
-    crate::limits::check_image_memory(description.resolution)?;
-    World::from_description(description).map_err(|e| e.to_string())
+    crate::limits::check_image_memory(description.resolution)
+        .map_err(|message| InputError::new(&description.file, message))?;
+    World::from_description(description)
 }
 
 /// A gather parameter given by the user, named as in the parameter table (`rays`,

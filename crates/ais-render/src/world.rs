@@ -140,6 +140,12 @@ fn build_shape(
 }
 
 impl World {
+    /// Renders at `resolution` from now on: the film's size and the camera's aspect.
+    pub fn set_resolution(&mut self, resolution: (u32, u32)) {
+        self.resolution = resolution;
+        self.camera = Camera::new(&self.description.camera, resolution.0, resolution.1);
+    }
+
     /// Loads meshes, applies transforms and builds the BVH.
     pub fn from_description(description: SceneDescription) -> Result<Self, InputError> {
         let mut warnings = description.warnings.clone();

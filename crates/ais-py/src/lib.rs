@@ -1,0 +1,24 @@
+//! # ais for Python
+//!
+//! The extension module `ais._ais` behind the Python package `ais`: scenes loaded once and
+//! rendered many times into numpy arrays ([`scene::Scene`]), with the GIL released while
+//! the renderer works, and errors raised as `ais.SceneError` naming the file and line.
+
+use pyo3::prelude::*;
+
+mod errors;
+mod images;
+mod options;
+mod scene;
+mod stats;
+
+/// The extension module.
+#[pymodule]
+fn _ais(module: &Bound<'_, PyModule>) -> PyResult<()> {
+    let py = module.py();
+    module.add("SceneError", py.get_type::<errors::SceneError>())?;
+    module.add_class::<scene::Scene>()?;
+    module.add_function(wrap_pyfunction!(images::write_exr, module)?)?;
+    module.add("__version__", env!("CARGO_PKG_VERSION"))?;
+    Ok(())
+}

@@ -1,0 +1,89 @@
+"""Type stubs of the extension module behind ``ais``."""
+
+import os
+from typing import Any, Dict, Literal, Optional, Tuple, Union, overload
+
+import numpy as np
+import numpy.typing as npt
+
+__version__: str
+
+class SceneError(ValueError):
+    """A scene, mesh or image that cannot be used."""
+
+    file: str
+    """The file at fault."""
+    line: Optional[int]
+    """The 1-based line, where known."""
+    message: str
+    """What is wrong."""
+
+class Scene:
+    """A Mitsuba 3 XML scene, loaded once (meshes read, BVH built) and rendered many times.
+
+    ``scene`` is a path, XML text (starting with ``<``), or None for the built-in default
+    scene; ``defines`` set the file's ``$name`` parameters. Scene warnings are issued as
+    ``UserWarning``.
+    """
+
+    def __init__(
+        self, scene: Union[str, "os.PathLike[str]", None] = None, **defines: Any
+    ) -> None: ...
+    @property
+    def resolution(self) -> Tuple[int, int]:
+        """The film size ``(width, height)`` renders use unless told otherwise."""
+    @property
+    def spp(self) -> int:
+        """The scene's samples per pixel."""
+    @property
+    def file(self) -> str:
+        """The scene file, or what stands for it."""
+    @overload
+    def render(
+        self,
+        *,
+        spp: Optional[int] = None,
+        resolution: Optional[Tuple[int, int]] = None,
+        rays: Optional[int] = None,
+        ais: Optional[str] = None,
+        strategy: Optional[str] = None,
+        seed: int = 0,
+        threads: Optional[int] = None,
+        crop: Optional[Tuple[int, int, int, int]] = None,
+        progress: bool = False,
+        stats: Literal[False] = False,
+        **gather: Any,
+    ) -> npt.NDArray[np.float32]: ...
+    @overload
+    def render(
+        self,
+        *,
+        spp: Optional[int] = None,
+        resolution: Optional[Tuple[int, int]] = None,
+        rays: Optional[int] = None,
+        ais: Optional[str] = None,
+        strategy: Optional[str] = None,
+        seed: int = 0,
+        threads: Optional[int] = None,
+        crop: Optional[Tuple[int, int, int, int]] = None,
+        progress: bool = False,
+        stats: Literal[True],
+        **gather: Any,
+    ) -> Tuple[npt.NDArray[np.float32], Dict[str, Any]]: ...
+    def render(self, **options: Any) -> Any:
+        """Renders the scene's direct light with the gather, releasing the GIL.
+
+        - ``spp``: samples per pixel (default: the scene's);
+        - ``resolution``: ``(width, height)`` (default: the scene's);
+        - ``rays``, ``ais``, ``strategy`` and any other gather parameter (docs/cli.md);
+        - ``seed``: the base seed; each pixel derives its own, so images do not depend on
+          ``threads`` (default: all cores);
+        - ``crop``: ``(x, y, w, h)`` in pixels of the whole image; returns that part, equal
+          to the same pixels of the whole render wherever pixels are independent;
+        - ``progress``: a progress bar on stderr;
+        - ``stats``: return ``(image, stats)``, the stats a dict of render time, rays and
+          the gather's counts per gather.
+        """
+
+def write_exr(path: Union[str, "os.PathLike[str]"], image: npt.NDArray[np.float32]) -> None:
+    """Writes an ``(H, W, 3)`` float32 image as an RGB EXR, all or nothing."""
