@@ -154,7 +154,9 @@ struct Job {
 
 impl Scene {
     fn read(&self) -> std::sync::RwLockReadGuard<'_, World> {
-        self.world.read().unwrap_or_else(|poisoned| poisoned.into_inner())
+        self.world
+            .read()
+            .unwrap_or_else(|poisoned| poisoned.into_inner())
     }
 
     /// Checks the options against the scene and builds the render's settings.
