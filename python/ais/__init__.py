@@ -15,6 +15,9 @@ built-in default scene. Keyword arguments of ``render`` are the render's own (``
 ``resolution``, ``seed``, ``threads``, ``crop``, ``progress``, ``stats``) and any parameter
 of the gather (``rays``, ``ais``, ``strategy``, ``budget``, ``cost_ratio``, ... as in
 docs/cli.md). Bad input raises :class:`SceneError`, which names the file and line.
+
+:class:`BatchSet` is the library for hosts: many gathers' AIS decisions per call, with
+arrays (see ``ais.batch_set``).
 """
 
 from __future__ import annotations
@@ -23,8 +26,9 @@ import os
 from typing import Any, Mapping, Optional, Union
 
 from ._ais import Scene, SceneError, __version__, write_exr
+from .batch_set import BatchSet
 
-__all__ = ["Scene", "SceneError", "render", "write_exr", "__version__"]
+__all__ = ["BatchSet", "Scene", "SceneError", "render", "write_exr", "__version__"]
 
 
 def render(

@@ -43,6 +43,7 @@ pub mod affinity_map;
 #[cfg(feature = "testing")]
 pub mod analytic;
 pub mod batch;
+pub mod batch_set;
 pub(crate) mod epochs;
 pub mod fast_trig;
 pub mod field;
@@ -61,6 +62,7 @@ pub use batch::{
     rating, Batch, BatchConfig, BatchConfigError, Candidate, Decision, Estimate, Learning,
     MapStart, Placement, RejectReason, Stopping,
 };
+pub use batch_set::{BatchSet, Round};
 pub use sampling::TexelDistribution;
 pub use stats::Stats;
 pub use value::Value;
