@@ -4,7 +4,8 @@
 //! on `python/tests`.
 //!
 //! Without Python 3 the test fails under CI (the `CI` variable is set) and otherwise
-//! prints SKIPPED with the reason. `AIS_PYTHON` picks the interpreter.
+//! prints SKIPPED with the reason; so do the tests of AIS inside Mitsuba without the LLVM
+//! library that Mitsuba's llvm variant needs. `AIS_PYTHON` picks the interpreter.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -64,7 +65,7 @@ fn the_python_package_passes_its_tests() {
     run(
         "pytest python/tests",
         Command::new(&venv_python)
-            .args(["-m", "pytest", "-q", "-p", "no:cacheprovider"])
+            .args(["-m", "pytest", "-q", "-rs", "-p", "no:cacheprovider"])
             .arg(root.join("python/tests"))
             .current_dir(&root),
     );
