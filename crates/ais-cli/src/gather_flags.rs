@@ -127,34 +127,3 @@ impl GatherFlags {
         Ok(settings)
     }
 }
-
-/// Settings from a configuration text of `name=value` words (the gather's parameter names),
-/// applied in the parameter table's order on top of `base`: e.g. "ais=shared
-/// acceptance=efficient".
-pub fn configuration(base: &GatherSettings, text: &str) -> Result<GatherSettings, String> {
-    let mut given = Vec::new();
-    for word in text.split_whitespace() {
-        let (name, value) = word
-            .split_once('=')
-            .ok_or_else(|| format!("\"{word}\" in \"{text}\" is not name=value"))?;
-        if !PARAMETERS.contains(&name) {
-            return Err(format!(
-                "unknown gather parameter \"{name}\" in \"{text}\" (known: {})",
-                PARAMETERS.join(", ")
-            ));
-        }
-        given.push((name, value));
-    }
-    let mut settings = *base;
-    for name in PARAMETERS {
-        for (_, value) in given.iter().filter(|(n, _)| *n == name) {
-            settings
-                .set(name, value)
-                .map_err(|m| format!("\"{text}\": {m}"))?;
-        }
-    }
-    settings
-        .validate()
-        .map_err(|m| format!("\"{text}\": {m}"))?;
-    Ok(settings)
-}

@@ -14,6 +14,8 @@ pub mod metrics;
 pub mod plots;
 pub mod reference;
 pub mod report;
+pub mod request;
+pub mod summary;
 
 use crate::oracle::Oracle;
 use ais::rng::mix64;

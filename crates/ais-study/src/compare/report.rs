@@ -4,7 +4,8 @@
 use super::affinity_figure::{snapshot_svg, SNAPSHOTS};
 use super::metrics::{relative_error_colours, rgbe};
 use super::plots::{LogLogPlot, Series};
-use super::{mean_and_error, ConfigurationResult, Run, StudyResults};
+use super::summary::{summary, Measured, SummaryRow};
+use super::{ConfigurationResult, Run, StudyResults};
 use ais_render::image_io::RgbImage;
 use base64::Engine;
 use std::fmt::Write;
@@ -29,60 +30,16 @@ pub struct ReportContext<'a> {
     pub figure_pixel: (u32, u32),
 }
 
-/// One row of the summary tables.
-struct Row<'a> {
-    result: &'a ConfigurationResult,
-    time_rel_mse: (f64, f64),
-    rays_rel_mse: (f64, f64),
-}
-
-/// Mean and standard error over runs of relMSE scaled to the budget: relMSE × cost /
-/// budget. A run stops after the pass that crosses its budget, so it overshoots by up to
-/// one pass; relMSE of an unbiased estimator falls as 1 / cost, so scaling removes the
-/// overshoot (it matters when a budget holds only a few passes).
-fn scaled_rel_mse(runs: &[Run], cost: impl Fn(&Run) -> f64, budget: f64) -> (f64, f64) {
-    if runs.is_empty() {
-        return (f64::NAN, f64::NAN);
-    }
-    let scaled: Vec<f64> = runs
-        .iter()
-        .map(|r| r.rel_mse() * cost(r) / budget)
-        .collect();
-    mean_and_error(&scaled)
-}
-
-fn rows<'a>(results: &'a StudyResults, context: &ReportContext) -> Vec<Row<'a>> {
-    results
-        .results
-        .iter()
-        .map(|result| Row {
-            result,
-            time_rel_mse: scaled_rel_mse(&result.equal_time, |r| r.seconds, context.time_budget),
-            rays_rel_mse: scaled_rel_mse(
-                &result.equal_rays,
-                |r| r.rays.total() as f64,
-                results.ray_budget as f64,
-            ),
-        })
-        .collect()
-}
-
-fn average(runs: &[Run], value: impl Fn(&Run) -> f64) -> f64 {
-    runs.iter().map(value).sum::<f64>() / runs.len().max(1) as f64
-}
-
 /// The summary tables as Markdown: equal time, then equal rays with the oracle's share.
 pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> String {
-    let rows = rows(results, context);
+    let rows = summary(results, context);
     let mut out = equal_time_table(results, context, &rows);
     out.push_str(&equal_rays_table(results, &rows));
     out
 }
 
-/// The baseline's relMSE over a configuration's, or a dash where it means nothing (a black
-/// scene, where both are 0).
-fn ratio(baseline: f64, value: f64) -> String {
-    let ratio = baseline / value;
+/// A ratio, or a dash where it means nothing (a black scene, where both are 0).
+fn ratio(ratio: f64) -> String {
     if ratio.is_finite() {
         format!("{ratio:.2}×")
     } else {
@@ -91,18 +48,20 @@ fn ratio(baseline: f64, value: f64) -> String {
 }
 
 /// A mean with its standard error; one seed has none.
-fn with_error((mean, error): (f64, f64)) -> String {
-    if error.is_finite() {
-        format!("{mean:.3e} ± {error:.1e}")
+fn with_error(measured: Measured) -> String {
+    if measured.error.is_finite() {
+        format!("{:.3e} ± {:.1e}", measured.mean, measured.error)
     } else {
-        format!("{mean:.3e} (one seed: no error bar)")
+        format!("{:.3e} (one seed: no error bar)", measured.mean)
     }
 }
 
 /// The equal-time table, with its introduction.
-fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row]) -> String {
-    let pixels = (context.resolution.0 * context.resolution.1) as f64;
-    let base = &rows[0];
+fn equal_time_table(
+    results: &StudyResults,
+    context: &ReportContext,
+    rows: &[SummaryRow],
+) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -114,30 +73,29 @@ fn equal_time_table(results: &StudyResults, context: &ReportContext, rows: &[Row
         results.reference.noise_floor()
     );
     out.push_str("| configuration | spp | ms per spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio |\n|---|---|---|---|---|---|---|---|---|\n");
-    for row in rows.iter().filter(|r| !r.result.equal_time.is_empty()) {
-        let runs = &row.result.equal_time;
-        let spp = average(runs, |r| r.spp as f64);
+    for row in rows {
+        let Some(time) = &row.equal_time else {
+            continue;
+        };
         let _ = writeln!(
             out,
             "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {} |",
-            row.result.configuration.name,
-            spp,
-            1e3 * average(runs, |r| r.seconds) / spp,
-            spp * context.rays as f64,
-            average(runs, |r| r.rays.occlusion as f64) / pixels,
-            average(runs, |r| r.stats.rejected_roulette as f64) / pixels,
-            average(runs, |r| r.ais_memory_per_thread as f64) / 1024.0,
-            with_error(row.time_rel_mse),
-            ratio(base.time_rel_mse.0, row.time_rel_mse.0)
+            row.name,
+            time.spp,
+            time.ms_per_spp,
+            time.nominal_rays_per_pixel,
+            time.traced_rays_per_pixel,
+            time.rejected_per_pixel,
+            time.ais_kib_per_thread,
+            with_error(time.rel_mse),
+            ratio(time.ratio)
         );
     }
     out
 }
 
-/// The equal-ray table with the oracle's share, with its introduction.
-fn equal_rays_table(results: &StudyResults, rows: &[Row]) -> String {
-    let base = &rows[0];
-    let oracle = rows.iter().find(|r| r.result.configuration.is_oracle());
+/// The equal-ray table, with its introduction.
+fn equal_rays_table(results: &StudyResults, rows: &[SummaryRow]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -149,19 +107,17 @@ fn equal_rays_table(results: &StudyResults, rows: &[Row]) -> String {
         "| configuration | spp | time (s) | relMSE | ratio | oracle share |\n|---|---|---|---|---|---|\n",
     );
     for row in rows {
-        let share = oracle.map_or(f64::NAN, |o| {
-            (base.rays_rel_mse.0 - row.rays_rel_mse.0) / (base.rays_rel_mse.0 - o.rays_rel_mse.0)
-        });
+        let rays = &row.equal_rays;
         let _ = writeln!(
             out,
             "| {} | {:.1} | {:.2} | {} | {} | {} |",
-            row.result.configuration.name,
-            average(&row.result.equal_rays, |r| r.spp as f64),
-            average(&row.result.equal_rays, |r| r.seconds),
-            with_error(row.rays_rel_mse),
-            ratio(base.rays_rel_mse.0, row.rays_rel_mse.0),
-            if share.is_finite() {
-                format!("{:.0}%", 100.0 * share)
+            row.name,
+            rays.spp,
+            rays.seconds,
+            with_error(rays.rel_mse),
+            ratio(rays.ratio),
+            if rays.oracle_share.is_finite() {
+                format!("{:.0}%", 100.0 * rays.oracle_share)
             } else {
                 "–".into()
             }
