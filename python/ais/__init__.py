@@ -16,7 +16,8 @@ built-in default scene. Keyword arguments of ``render`` are the render's own (``
 of the gather (``rays``, ``ais``, ``strategy``, ``budget``, ``cost_ratio``, ... as in
 docs/cli.md). Bad input raises :class:`SceneError`, which names the file and line.
 
-:class:`BatchSet` is the library for hosts: many gathers' AIS decisions per call, with
+:func:`compare` runs the study of ``ais compare``: it writes the HTML report and returns
+the tables as dicts. :class:`BatchSet` is the library for hosts: many gathers' AIS decisions per call, with
 arrays (see ``ais.batch_set``).
 """
 
@@ -25,10 +26,10 @@ from __future__ import annotations
 import os
 from typing import Any, Mapping, Optional, Union
 
-from ._ais import Scene, SceneError, __version__, write_exr
+from ._ais import Scene, SceneError, __version__, compare, write_exr
 from .batch_set import BatchSet
 
-__all__ = ["BatchSet", "Scene", "SceneError", "render", "write_exr", "__version__"]
+__all__ = ["BatchSet", "Scene", "SceneError", "compare", "render", "write_exr", "__version__"]
 
 
 def render(

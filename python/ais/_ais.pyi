@@ -1,7 +1,7 @@
 """Type stubs of the extension module behind ``ais``."""
 
 import os
-from typing import Any, Dict, Literal, Optional, Tuple, Union, overload
+from typing import Any, Dict, List, Literal, Optional, Tuple, Union, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -106,3 +106,31 @@ class _BatchSet:
     ) -> Tuple[npt.NDArray[np.float32], npt.NDArray[np.uint32], npt.NDArray[np.uint32]]: ...
     @property
     def stats(self) -> Dict[str, int]: ...
+
+def compare(
+    scene: Union[str, "os.PathLike[str]", None] = None,
+    *,
+    output: Union[str, "os.PathLike[str]"] = "report",
+    time_budget: float = 3.0,
+    seeds: int = 3,
+    strategies: Optional[List[str]] = None,
+    configs: Optional[List[str]] = None,
+    oracle: bool = True,
+    reference_spp: int = 256,
+    pass_spp: int = 1,
+    pixel: Optional[Tuple[int, int]] = None,
+    resolution: Optional[Tuple[int, int]] = None,
+    defines: Optional[Dict[str, Any]] = None,
+    threads: Optional[int] = None,
+    progress: bool = False,
+    **gather: Any,
+) -> Dict[str, Any]:
+    """The study of ``ais compare`` (docs/cli.md): configurations at equal time and equal
+    rays against a converged reference, with the oracle. Writes ``output/index.html`` and
+    returns ``{"configurations": [...], "tables": str, "report": str, "ray_budget": int,
+    "reference_noise": float}``; each configuration is a dict with ``name``, ``label``,
+    ``oracle``, ``equal_time`` (None for the oracle: spp, ms_per_spp, traced_rays_per_pixel,
+    rejected_per_pixel, ais_kib_per_thread, rel_mse {mean, error}, ratio) and
+    ``equal_rays`` (spp, seconds, rel_mse, ratio, oracle_share). The first configuration is
+    the baseline of the ratios. Gather parameters (``rays=…``) set the base settings.
+    """

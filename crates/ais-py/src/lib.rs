@@ -8,6 +8,7 @@
 use pyo3::prelude::*;
 
 mod batch_set;
+mod compare;
 mod errors;
 mod images;
 mod options;
@@ -22,6 +23,7 @@ fn _ais(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add_class::<scene::Scene>()?;
     module.add_class::<batch_set::PyBatchSet>()?;
     module.add_function(wrap_pyfunction!(images::write_exr, module)?)?;
+    module.add_function(wrap_pyfunction!(compare::compare, module)?)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

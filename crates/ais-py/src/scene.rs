@@ -54,7 +54,7 @@ fn source(scene: Option<&Bound<'_, PyAny>>) -> PyResult<Source> {
 }
 
 /// `**defines` as `(name, text)` pairs.
-fn defines(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, String)>> {
+pub fn defines(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, String)>> {
     let Some(kwargs) = kwargs else {
         return Ok(Vec::new());
     };
@@ -62,6 +62,36 @@ fn defines(kwargs: Option<&Bound<'_, PyDict>>) -> PyResult<Vec<(String, String)>
         .iter()
         .map(|(name, value)| Ok((name.extract()?, parameter_text(&value)?)))
         .collect()
+}
+
+/// Loads a scene argument (a path, XML text or None) without the GIL; issues its
+/// warnings as Python warnings.
+pub fn load(
+    py: Python<'_>,
+    scene: Option<&Bound<'_, PyAny>>,
+    defines: &[(String, String)],
+    resolution: Option<(u32, u32)>,
+) -> PyResult<World> {
+    let source = source(scene)?;
+    let world = py.detach(|| {
+        let source = match &source {
+            Source::Text(text) => SceneSource::Text {
+                text,
+                name: std::path::Path::new("<xml text>"),
+            },
+            Source::File(path) => SceneSource::File(path),
+            Source::BuiltIn => SceneSource::BuiltIn,
+        };
+        load_world(&SceneRequest {
+            source,
+            defines,
+            resolution,
+            default_resolution: BUILT_IN_RESOLUTION,
+        })
+    });
+    let world = world.map_err(|e| scene_error(py, &e))?;
+    warn_all(py, &world.warnings)?;
+    Ok(world)
 }
 
 #[pymethods]
@@ -74,26 +104,8 @@ impl Scene {
         scene: Option<&Bound<'_, PyAny>>,
         defines: Option<&Bound<'_, PyDict>>,
     ) -> PyResult<Self> {
-        let source = source(scene)?;
         let defines = self::defines(defines)?;
-        let world = py.detach(|| {
-            let source = match &source {
-                Source::Text(text) => SceneSource::Text {
-                    text,
-                    name: std::path::Path::new("<xml text>"),
-                },
-                Source::File(path) => SceneSource::File(path),
-                Source::BuiltIn => SceneSource::BuiltIn,
-            };
-            load_world(&SceneRequest {
-                source,
-                defines: &defines,
-                resolution: None,
-                default_resolution: BUILT_IN_RESOLUTION,
-            })
-        });
-        let world = world.map_err(|e| scene_error(py, &e))?;
-        warn_all(py, &world.warnings)?;
+        let world = load(py, scene, &defines, None)?;
         Ok(Scene {
             name: world.description.file.display().to_string(),
             resolution: world.resolution,
@@ -206,14 +218,21 @@ impl Scene {
         }
         let world = self.read();
         let integrator = Integrator::Gather(job.gather);
-        let work = || render(&world, &integrator, &job.settings);
-        match threads {
-            None => Ok(work()),
-            Some(threads) => rayon::ThreadPoolBuilder::new()
+        on_threads(threads, || render(&world, &integrator, &job.settings))
+    }
+}
+
+/// Runs `work` on `threads` threads (None: the global pool, one per core).
+pub fn on_threads<T: Send>(threads: Option<usize>, work: impl FnOnce() -> T + Send) -> PyResult<T> {
+    match threads {
+        None => Ok(work()),
+        Some(threads) => {
+            ais_render::limits::check_threads(threads, false).map_err(argument_error)?;
+            rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .map(|pool| pool.install(work))
-                .map_err(|e| argument_error(format!("cannot start {threads} threads: {e}"))),
+                .map_err(|e| argument_error(format!("cannot start {threads} threads: {e}")))
         }
     }
 }
