@@ -252,6 +252,22 @@ class Candidates:
         return np.ascontiguousarray(values), ratings
 
 
+def direct_reference(mi, path: Path, spp: int, defines: Dict[str, Any], samples: int = 4):
+    """Mitsuba's own ``direct`` integrator on the scene (``samples`` emitter and BSDF samples
+    per camera ray), for comparison: an ``(H, W, 3)`` float32 array."""
+    text = mitsuba_text(path.read_text())
+    direct = (
+        f'<integrator type="direct"><integer name="emitter_samples" value="{samples}"/>'
+        f'<integer name="bsdf_samples" value="{samples}"/></integrator>'
+    )
+    text, count = re.subn(r"<integrator\b.*?(/>|</integrator>)", direct, text, count=1, flags=re.S)
+    if count == 0:
+        text = text.replace("</scene>", direct + "</scene>")
+    mi.file_resolver().prepend(str(path.resolve().parent))
+    scene = mi.load_string(text, **{k: str(v) for k, v in defines.items()})
+    return np.asarray(mi.render(scene, spp=spp), dtype=np.float32)[:, :, :3]
+
+
 def render(
     scene: os.PathLike,
     *,
@@ -280,13 +296,26 @@ def main(argv=None) -> int:
     parser.add_argument("--variant", default="llvm_ad_rgb", help="Mitsuba variant")
     parser.add_argument("-D", dest="defines", action="append", default=[], help="name=value")
     parser.add_argument("-o", "--output", type=Path, required=True, help="output EXR")
+    parser.add_argument(
+        "--mitsuba-direct", action="store_true",
+        help="render with Mitsuba's own direct integrator instead (for comparison)",
+    )
     args = parser.parse_args(argv)
     if args.spp < 1 or args.rays < 1:
         parser.error("--spp and --rays must be at least 1")
     if args.output.suffix.lower() != ".exr":
         parser.error(f"{args.output}: the output must be an .exr file")
     defines = dict(d.split("=", 1) for d in args.defines if "=" in d)
+    from . import write_exr
+
     try:
+        if args.mitsuba_direct:
+            mi = import_mitsuba(args.variant)
+            started = time.perf_counter()
+            image = direct_reference(mi, args.scene, args.spp, defines)
+            write_exr(args.output, np.ascontiguousarray(image))
+            print(f"{args.output}: Mitsuba's direct integrator, {time.perf_counter() - started:.2f} s")
+            return 0
         image, stats = render(
             args.scene, spp=args.spp, rays=args.rays, ais=args.ais, seed=args.seed,
             variant=args.variant, defines=defines,
@@ -294,8 +323,6 @@ def main(argv=None) -> int:
     except (RuntimeError, ValueError, OSError) as error:
         print(f"error: {error}", file=sys.stderr)
         return 1
-    from . import write_exr
-
     write_exr(args.output, image)
     gathers = max(stats["gathers"], 1)
     print(

@@ -27,19 +27,12 @@ if find_llvm() is None:
     pytest.skip(f"SKIPPED the tests of AIS inside Mitsuba: {REASON}", allow_module_level=True)
 
 REFERENCE = """
-import os, re, sys, numpy as np
-from ais.mitsuba import import_mitsuba, mitsuba_text
+import sys, numpy as np
+from pathlib import Path
+from ais.mitsuba import direct_reference, import_mitsuba
 mi = import_mitsuba("llvm_ad_rgb")
-path, spp, out = sys.argv[1], int(sys.argv[2]), sys.argv[3]
-direct = ('<integrator type="direct"><integer name="emitter_samples" value="4"/>'
-          '<integer name="bsdf_samples" value="4"/></integrator>')
-text = mitsuba_text(open(path).read())
-text, count = re.subn(r'<integrator\\b.*?(/>|</integrator>)', direct, text, count=1, flags=re.S)
-if count == 0:
-    text = text.replace("</scene>", direct + "</scene>")
-mi.file_resolver().prepend(os.path.dirname(os.path.abspath(path)))
-scene = mi.load_string(text, res_x="64", res_y="48")
-np.save(out, np.asarray(mi.render(scene, spp=spp)))
+image = direct_reference(mi, Path(sys.argv[1]), int(sys.argv[2]), {"res_x": 64, "res_y": 48})
+np.save(sys.argv[3], image)
 """
 
 OURS = """

@@ -1,6 +1,7 @@
 //! `ais._BatchSet`: the library's [`ais::BatchSet`] over numpy arrays, so that a Python host
 //! drives many gathers per call (the package's `ais.BatchSet` wraps it and converts
-//! arrays). Values are RGB.
+//! arrays). Values are RGB. Gathers are split into chunks that run in parallel without the
+//! GIL.
 
 use crate::errors::argument_error;
 use crate::options::parameter_text;
@@ -10,20 +11,29 @@ use numpy::ndarray::{Array1, Array2};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+use rayon::prelude::*;
 use std::sync::Mutex;
 
 /// The gather parameters a batch set takes (the rest need the renderer's neighbours).
 const BATCH_PARAMETERS: [&str; 5] = ["ais", "budget", "placement", "map_res", "tol"];
 
+/// Gathers per chunk: each chunk is a library `BatchSet` of its own, and chunks run in
+/// parallel on rayon's threads (a chunk's batches stay in one thread's cache).
+const CHUNK: usize = 1024;
+
 /// Many gathers' batches, driven a round at a time with arrays.
 #[pyclass(module = "ais", frozen, name = "_BatchSet")]
 pub struct PyBatchSet {
-    state: Mutex<State>,
+    state: Mutex<Vec<Chunk>>,
+    gathers: usize,
 }
 
-struct State {
+/// Consecutive gathers driven by one library batch set.
+struct Chunk {
     set: BatchSet<[f32; 3]>,
     round: Round<[f32; 3]>,
+    /// The index of its first gather.
+    start: usize,
 }
 
 /// The library configuration from `ais=…` and the other batch parameters.
@@ -69,25 +79,34 @@ impl PyBatchSet {
     #[pyo3(signature = (gathers, **options))]
     fn new(gathers: usize, options: Option<&Bound<'_, PyDict>>) -> PyResult<Self> {
         let config = batch_config(options)?;
-        let set = BatchSet::new(config, gathers).map_err(|e| argument_error(format!("{e:?}")))?;
-        let round = set.round_buffers();
+        let mut chunks = Vec::new();
+        for start in (0..gathers).step_by(CHUNK) {
+            let set = BatchSet::new(config, CHUNK.min(gathers - start))
+                .map_err(|e| argument_error(format!("{e:?}")))?;
+            let round = set.round_buffers();
+            chunks.push(Chunk { set, round, start });
+        }
         Ok(PyBatchSet {
-            state: Mutex::new(State { set, round }),
+            state: Mutex::new(chunks),
+            gathers,
         })
     }
 
     fn __len__(&self) -> usize {
-        self.lock().set.len()
+        self.gathers
     }
 
     fn begin(&self, n: u32, seeds: PyReadonlyArray1<'_, u64>) -> PyResult<()> {
-        let mut state = self.lock();
         let seeds = seeds.as_array();
-        check_rows("seeds", seeds.len(), state.set.len())?;
+        check_rows("seeds", seeds.len(), self.gathers)?;
         if n == 0 {
             return Err(argument_error("n must be at least 1"));
         }
-        state.set.begin(n, &seeds.to_vec());
+        let seeds = seeds.to_vec();
+        for chunk in self.lock().iter_mut() {
+            let end = chunk.start + chunk.set.len();
+            chunk.set.begin(n, &seeds[chunk.start..end]);
+        }
         Ok(())
     }
 
@@ -95,17 +114,23 @@ impl PyBatchSet {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let mut state = self.lock();
-        let State { set, round } = &mut *state;
-        if set.awaits_record() {
+        let mut chunks = self.lock();
+        if chunks.iter().any(|c| c.set.awaits_record()) {
             return Err(argument_error(
                 "record() the traced candidates before the next round",
             ));
         }
-        set.next_candidates(round);
-        let active = Array1::from(round.active.clone()).into_pyarray(py);
-        let u = Array2::from(round.u.clone()).into_pyarray(py);
-        Ok((active.into_any(), u.into_any()))
+        let all: &mut [Chunk] = &mut chunks;
+        py.detach(|| {
+            all.par_iter_mut()
+                .for_each(|c| _ = c.set.next_candidates(&mut c.round));
+        });
+        let active: Vec<bool> = chunks.iter().flat_map(|c| c.round.active.clone()).collect();
+        let u: Vec<[f32; 2]> = chunks.iter().flat_map(|c| c.round.u.clone()).collect();
+        Ok((
+            Array1::from(active).into_pyarray(py).into_any(),
+            Array2::from(u).into_pyarray(py).into_any(),
+        ))
     }
 
     fn decide<'py>(
@@ -114,42 +139,52 @@ impl PyBatchSet {
         directions: PyReadonlyArray2<'_, f32>,
         in_support: PyReadonlyArray1<'_, bool>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let mut state = self.lock();
-        let State { set, round } = &mut *state;
         let (directions, in_support) = (directions.as_array(), in_support.as_array());
-        check_rows("directions", directions.nrows(), set.len())?;
-        check_rows("in_support", in_support.len(), set.len())?;
+        check_rows("directions", directions.nrows(), self.gathers)?;
+        check_rows("in_support", in_support.len(), self.gathers)?;
         if directions.ncols() != 3 {
             return Err(argument_error("directions must have 3 columns"));
         }
-        for (g, row) in directions.outer_iter().enumerate() {
-            round.directions[g] = [row[0], row[1], row[2]];
-            round.in_support[g] = in_support[g];
+        let mut chunks = self.lock();
+        for chunk in chunks.iter_mut() {
+            for g in 0..chunk.set.len() {
+                let row = directions.row(chunk.start + g);
+                chunk.round.directions[g] = [row[0], row[1], row[2]];
+                chunk.round.in_support[g] = in_support[chunk.start + g];
+            }
         }
-        set.decide(round);
-        let trace = Array1::from(round.trace.clone()).into_pyarray(py);
-        let weight = Array1::from(round.weight.clone()).into_pyarray(py);
-        Ok((trace.into_any(), weight.into_any()))
+        let all: &mut [Chunk] = &mut chunks;
+        py.detach(|| all.par_iter_mut().for_each(|c| c.set.decide(&mut c.round)));
+        let trace: Vec<bool> = chunks.iter().flat_map(|c| c.round.trace.clone()).collect();
+        let weight: Vec<f32> = chunks.iter().flat_map(|c| c.round.weight.clone()).collect();
+        Ok((
+            Array1::from(trace).into_pyarray(py).into_any(),
+            Array1::from(weight).into_pyarray(py).into_any(),
+        ))
     }
 
     fn record(
         &self,
+        py: Python<'_>,
         contributions: PyReadonlyArray2<'_, f32>,
         ratings: PyReadonlyArray1<'_, f32>,
     ) -> PyResult<()> {
-        let mut state = self.lock();
-        let State { set, round } = &mut *state;
         let (contributions, ratings) = (contributions.as_array(), ratings.as_array());
-        check_rows("contributions", contributions.nrows(), set.len())?;
-        check_rows("ratings", ratings.len(), set.len())?;
+        check_rows("contributions", contributions.nrows(), self.gathers)?;
+        check_rows("ratings", ratings.len(), self.gathers)?;
         if contributions.ncols() != 3 {
             return Err(argument_error("contributions must have 3 columns (RGB)"));
         }
-        for (g, row) in contributions.outer_iter().enumerate() {
-            round.contributions[g] = [row[0], row[1], row[2]];
-            round.ratings[g] = ratings[g];
+        let mut chunks = self.lock();
+        for chunk in chunks.iter_mut() {
+            for g in 0..chunk.set.len() {
+                let row = contributions.row(chunk.start + g);
+                chunk.round.contributions[g] = [row[0], row[1], row[2]];
+                chunk.round.ratings[g] = ratings[chunk.start + g];
+            }
         }
-        set.record(round);
+        let all: &mut [Chunk] = &mut chunks;
+        py.detach(|| all.par_iter_mut().for_each(|c| c.set.record(&c.round)));
         Ok(())
     }
 
@@ -157,13 +192,13 @@ impl PyBatchSet {
         &self,
         py: Python<'py>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>, Bound<'py, PyAny>)> {
-        let mut state = self.lock();
-        if !state.set.is_finished() {
+        let mut chunks = self.lock();
+        if !chunks.iter().all(|c| c.set.is_finished()) {
             return Err(argument_error(
                 "finish() before every gather completed: call next_candidates() until none is active",
             ));
         }
-        let estimates = state.set.finish();
+        let estimates: Vec<_> = chunks.iter_mut().flat_map(|c| c.set.finish()).collect();
         let values: Vec<[f32; 3]> = estimates.iter().map(|e| e.value).collect();
         let candidates: Vec<u32> = estimates.iter().map(|e| e.candidates).collect();
         let traced: Vec<u32> = estimates.iter().map(|e| e.traced).collect();
@@ -177,7 +212,10 @@ impl PyBatchSet {
     /// Counters summed over every gather so far.
     #[getter]
     fn stats<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
-        let stats = self.lock().set.stats();
+        let mut stats = ais::Stats::default();
+        for chunk in self.lock().iter() {
+            stats.merge(&chunk.set.stats());
+        }
         let dict = PyDict::new(py);
         dict.set_item("gathers", stats.batches)?;
         dict.set_item("candidates", stats.candidates)?;
@@ -189,7 +227,7 @@ impl PyBatchSet {
 }
 
 impl PyBatchSet {
-    fn lock(&self) -> std::sync::MutexGuard<'_, State> {
+    fn lock(&self) -> std::sync::MutexGuard<'_, Vec<Chunk>> {
         self.state.lock().unwrap_or_else(|p| p.into_inner())
     }
 }
