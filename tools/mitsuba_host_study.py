@@ -5,8 +5,9 @@ For each scene: a reference rendered by the same host with AIS off at --referenc
 estimator, same box filter), then every mode at --spp for --seeds seeds, each render timed
 after a warm-up (Dr.Jit compiles its kernels on the first). Prints per mode: traced rays
 per gather, time, relMSE = mean((x − r)² / (r² + 0.01)) less the reference's own noise,
-and the efficiency ratio against AIS off, (relMSE_off · t_off) / (relMSE · t), with its
-standard error over seeds. One Mitsuba scene per process.
+and the efficiency ratios against AIS off: at equal time, (relMSE_off · t_off) / (relMSE · t),
+with its standard error over seeds, and at equal traced rays, (relMSE_off · traced_off) /
+(relMSE · traced). One Mitsuba scene per process.
 
     python tools/mitsuba_host_study.py scenes/sunlit_room.xml scenes/cornell_box.xml
 
@@ -73,11 +74,11 @@ def study(scene, args, folder):
     base_errors, base_times, _ = rows[args.modes[0]]
     base = base_errors.mean() * base_times.mean()
     print(f"\n{scene}: {args.resolution}, {args.spp} spp, n = {args.rays}, {args.seeds} seeds")
-    print("| mode | traced/gather | time (s) | relMSE | efficiency vs first |")
-    print("|---|---|---|---|---|")
+    print("| mode | traced/gather | time (s) | relMSE | equal time vs first | equal traced rays vs first |")
+    print("|---|---|---|---|---|---|")
     for mode, (errors, times, traced) in rows.items():
         if mode == args.modes[0]:
-            print(f"| {mode} | {traced:.1f} | {times.mean():.2f} | {errors.mean():.3e} | 1 (baseline) |")
+            print(f"| {mode} | {traced:.1f} | {times.mean():.2f} | {errors.mean():.3e} | 1 (baseline) | 1 |")
             continue
         cost = errors.mean() * times.mean()
         # Relative errors of the two means, combined (seeds are independent).
@@ -85,8 +86,9 @@ def study(scene, args, folder):
         spread = np.hypot(spread, np.hypot(base_errors.std(ddof=1) / base_errors.mean(),
                                            base_times.std(ddof=1) / base_times.mean()))
         ratio = base / cost
+        by_rays = base_errors.mean() * rows[args.modes[0]][2] / (errors.mean() * traced)
         print(f"| {mode} | {traced:.1f} | {times.mean():.2f} | {errors.mean():.3e} | "
-              f"{ratio:.2f}× ± {ratio * spread / np.sqrt(args.seeds):.2f} |")
+              f"{ratio:.2f}× ± {ratio * spread / np.sqrt(args.seeds):.2f} | {by_rays:.2f}× |")
 
 
 def main():

@@ -27,9 +27,9 @@ import os
 from typing import Any, Mapping, Optional, Union
 
 from ._ais import Scene, SceneError, __version__, compare, write_exr
-from .batch_set import BatchSet
+from .batch_set import BatchSet, VisibilityField
 
-__all__ = ["BatchSet", "Scene", "SceneError", "compare", "render", "write_exr", "__version__"]
+__all__ = ["BatchSet", "Scene", "VisibilityField", "SceneError", "compare", "render", "write_exr", "__version__"]
 
 
 def render(

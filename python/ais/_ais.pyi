@@ -96,7 +96,10 @@ class _BatchSet:
     def begin(self, n: int, seeds: npt.NDArray[np.uint64]) -> None: ...
     def next_candidates(self) -> Tuple[npt.NDArray[np.bool_], npt.NDArray[np.float32]]: ...
     def decide(
-        self, directions: npt.NDArray[np.float32], in_support: npt.NDArray[np.bool_]
+        self,
+        directions: npt.NDArray[np.float32],
+        in_support: npt.NDArray[np.bool_],
+        acceptance: Optional[npt.NDArray[np.float32]] = None,
     ) -> Tuple[npt.NDArray[np.bool_], npt.NDArray[np.float32]]: ...
     def record(
         self, contributions: npt.NDArray[np.float32], ratings: npt.NDArray[np.float32]
@@ -134,3 +137,30 @@ def compare(
     ``equal_rays`` (spp, seconds, rel_mse, ratio, oracle_share). The first configuration is
     the baseline of the ratios. Gather parameters (``rays=…``) set the base settings.
     """
+
+class VisibilityField:
+    """The extension's learned field; use ``ais.VisibilityField``, which converts arrays."""
+
+    def __init__(self, side: int = 8, prior: float = 2.0) -> None: ...
+    def acceptance(
+        self,
+        positions: npt.NDArray[np.float32],
+        normals: npt.NDArray[np.float32],
+        spacings: npt.NDArray[np.float32],
+        directions: npt.NDArray[np.float32],
+        cost_ratio: float,
+    ) -> npt.NDArray[np.float32]: ...
+    def record(
+        self,
+        positions: npt.NDArray[np.float32],
+        normals: npt.NDArray[np.float32],
+        spacings: npt.NDArray[np.float32],
+        directions: npt.NDArray[np.float32],
+        free: npt.NDArray[np.bool_],
+        traced: npt.NDArray[np.bool_],
+    ) -> None: ...
+    def end_pass(self) -> None: ...
+    @property
+    def cell_count(self) -> int: ...
+    @property
+    def memory_bytes(self) -> int: ...

@@ -79,3 +79,39 @@ def test_bad_arguments_are_refused():
     assert trace.all(), "AIS off traces every candidate"
     with pytest.raises(ValueError, match="record"):
         batches.next_candidates()
+
+
+def test_a_learned_field_rejects_blocked_candidates_without_bias():
+    """Gathers along a line, each under a sky blocked where x < 0; the field learns that
+    over passes and the estimates stay unbiased (exactly 1/2)."""
+    gathers, n = 4000, 16
+    positions = np.zeros((gathers, 3), dtype=np.float32)
+    positions[:, 0] = np.linspace(0, 1, gathers)
+    normals = np.tile(np.array([0, 0, 1], dtype=np.float32), (gathers, 1))
+    spacings = np.full(gathers, 0.05, dtype=np.float32)
+    field = ais.VisibilityField()
+    passes = []
+    for index in range(4):
+        batches = ais.BatchSet(gathers, ais="off")
+        batches.begin(n, 1000 * index)
+        while True:
+            active, u = batches.next_candidates()
+            if not active.any():
+                break
+            directions = hemisphere(u)
+            acceptance = field.acceptance(positions, normals, spacings, directions, 0.2)
+            trace, _ = batches.decide(directions, np.ones(gathers, dtype=bool), acceptance)
+            visible = directions[:, 0] > 0
+            value = np.where(visible, 2.0 * directions[:, 2], 0.0)
+            batches.record(np.repeat(value[:, None], 3, axis=1), visible.astype(np.float32))
+            field.record(positions, normals, spacings, directions, visible, trace)
+        field.end_pass()
+        passes.append((batches.finish(), batches.stats))
+    assert field.cell_count > 0 and field.memory_bytes > 0
+    (first, first_stats), (last, last_stats) = passes[0], passes[-1]
+    assert first_stats["rejected_by_roulette"] == 0, "nothing is known in the first pass"
+    assert last_stats["rejected_by_roulette"] > 0.2 * last_stats["candidates"]
+    for (estimates, _, _), _ in passes:
+        mean = estimates[:, 0].astype(np.float64).mean()
+        standard_error = estimates[:, 0].std(ddof=1) / np.sqrt(gathers)
+        assert abs(mean - 0.5) < 4 * standard_error, (mean, standard_error)

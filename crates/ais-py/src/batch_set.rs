@@ -133,15 +133,21 @@ impl PyBatchSet {
         ))
     }
 
+    #[pyo3(signature = (directions, in_support, acceptance=None))]
     fn decide<'py>(
         &self,
         py: Python<'py>,
         directions: PyReadonlyArray2<'_, f32>,
         in_support: PyReadonlyArray1<'_, bool>,
+        acceptance: Option<PyReadonlyArray1<'_, f32>>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let (directions, in_support) = (directions.as_array(), in_support.as_array());
         check_rows("directions", directions.nrows(), self.gathers)?;
         check_rows("in_support", in_support.len(), self.gathers)?;
+        let acceptance = acceptance.map(|a| a.as_array().to_vec());
+        if let Some(acceptance) = &acceptance {
+            check_rows("acceptance", acceptance.len(), self.gathers)?;
+        }
         if directions.ncols() != 3 {
             return Err(argument_error("directions must have 3 columns"));
         }
@@ -154,7 +160,15 @@ impl PyBatchSet {
             }
         }
         let all: &mut [Chunk] = &mut chunks;
-        py.detach(|| all.par_iter_mut().for_each(|c| c.set.decide(&mut c.round)));
+        py.detach(|| {
+            all.par_iter_mut().for_each(|c| match &acceptance {
+                None => c.set.decide(&mut c.round),
+                Some(acceptance) => {
+                    let own = &acceptance[c.start..c.start + c.set.len()];
+                    c.set.decide_with(&mut c.round, own)
+                }
+            })
+        });
         let trace: Vec<bool> = chunks.iter().flat_map(|c| c.round.trace.clone()).collect();
         let weight: Vec<f32> = chunks.iter().flat_map(|c| c.round.weight.clone()).collect();
         Ok((

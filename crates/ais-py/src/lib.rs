@@ -10,6 +10,7 @@ use pyo3::prelude::*;
 mod batch_set;
 mod compare;
 mod errors;
+mod field;
 mod images;
 mod options;
 mod scene;
@@ -22,6 +23,7 @@ fn _ais(module: &Bound<'_, PyModule>) -> PyResult<()> {
     module.add("SceneError", py.get_type::<errors::SceneError>())?;
     module.add_class::<scene::Scene>()?;
     module.add_class::<batch_set::PyBatchSet>()?;
+    module.add_class::<field::PyVisibilityField>()?;
     module.add_function(wrap_pyfunction!(images::write_exr, module)?)?;
     module.add_function(wrap_pyfunction!(compare::compare, module)?)?;
     module.add("__version__", env!("CARGO_PKG_VERSION"))?;

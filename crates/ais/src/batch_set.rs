@@ -182,11 +182,30 @@ impl<V: Value> BatchSet<V> {
     /// Decides the round's candidates from `round.directions` and `round.in_support`:
     /// sets `round.trace` and `round.weight`.
     pub fn decide(&mut self, round: &mut Round<V>) {
+        self.decide_each(round, |_, affinity| affinity);
+    }
+
+    /// [`BatchSet::decide`] with the host's acceptance probability for each gather's
+    /// candidate, `acceptance[g]` (see [`Batch::decide_with`]: it may depend on the
+    /// candidate and the past, not on the candidate's own roulette number), e.g. from a
+    /// learned [`crate::field::VisibilityField`] with AIS off in the batches.
+    ///
+    /// # Panics
+    /// If `acceptance` does not hold one value per gather.
+    pub fn decide_with(&mut self, round: &mut Round<V>, acceptance: &[f32]) {
+        assert_eq!(acceptance.len(), self.len(), "one acceptance per gather");
+        self.decide_each(round, |g, _| acceptance[g]);
+    }
+
+    fn decide_each(&mut self, round: &mut Round<V>, acceptance: impl Fn(usize, f32) -> f32) {
         for g in 0..self.len() {
             if self.slots[g] != Slot::Drawn {
                 continue;
             }
-            let decision = self.batches[g].decide(round.directions[g], round.in_support[g]);
+            let decision =
+                self.batches[g].decide_with(round.directions[g], round.in_support[g], |affinity| {
+                    acceptance(g, affinity)
+                });
             (round.trace[g], round.weight[g], self.slots[g]) = match decision {
                 Decision::Trace { weight } => (true, weight, Slot::Tracing),
                 Decision::Reject(_) => (false, 0.0, Slot::Idle),
