@@ -89,7 +89,8 @@ impl PyVisibilityField {
         };
         let directions = directions.as_array();
         sites.check(directions.nrows())?;
-        let state = self.lock();
+        let mut state = self.lock();
+        state.field.plan(cost_ratio);
         let acceptance: Vec<f32> = (0..directions.nrows())
             .map(|g| match state.field.cell(&sites.key(g)) {
                 Some(cell) if cell.worth_rolling(cost_ratio) => {

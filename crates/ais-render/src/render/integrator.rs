@@ -26,6 +26,9 @@ pub trait Learning: Sync {
 
     /// Adds a tile's observations. The result must not depend on the order of tiles.
     fn merge(&mut self, observed: Self::Observed);
+
+    /// Called once a pass's observations are all merged, before the next pass starts.
+    fn end_pass(&mut self) {}
 }
 
 impl Learning for () {

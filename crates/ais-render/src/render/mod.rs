@@ -167,6 +167,7 @@ pub fn render_learning<I: SampleIntegrator>(
         for result in results {
             learned.merge(output.add(result, samples, settings.samples_per_pixel));
         }
+        learned.end_pass();
     }
     progress.finish_and_clear();
     RenderOutput {

@@ -139,6 +139,10 @@ pub struct VisibilityField {
     totals: Vec<TexelCounts>,
     /// Per cell, the lowest visibility of its texels.
     darkest: Vec<f32>,
+    /// The cost ratio of the last [`VisibilityField::plan`] (None after a merge).
+    planned: Option<f32>,
+    /// Per cell, the share of its candidates roulette skips at the planned cost ratio.
+    expected_rejection: Vec<f32>,
 }
 
 /// Texels per side of a cell's map by default: 64 texels of 0.2 sr each.
@@ -160,6 +164,8 @@ impl VisibilityField {
             counts: Vec::new(),
             totals: Vec::new(),
             darkest: Vec::new(),
+            planned: None,
+            expected_rejection: Vec::new(),
         }
     }
 
@@ -191,7 +197,26 @@ impl VisibilityField {
         std::mem::size_of::<Self>()
             + self.cells.capacity() * (std::mem::size_of::<(CellKey, u32)>() + 1)
             + (self.counts.capacity() + self.totals.capacity()) * std::mem::size_of::<TexelCounts>()
-            + self.darkest.capacity() * std::mem::size_of::<f32>()
+            + (self.darkest.capacity() + self.expected_rejection.capacity())
+                * std::mem::size_of::<f32>()
+    }
+
+    /// Works out, for every cell, the share of its candidates that roulette at `cost_ratio`
+    /// would skip ([`FieldCell::expected_rejection`]), so that gathers can tell at once
+    /// whether roulette pays there. Call it once a pass's observations are merged, with
+    /// the cost ratio of the next pass; without it the share is worked out per lookup.
+    pub fn plan(&mut self, cost_ratio: f32) {
+        if self.planned == Some(cost_ratio) {
+            return;
+        }
+        let texels = (self.side * self.side) as usize;
+        self.expected_rejection = (0..self.totals.len())
+            .map(|cell| {
+                let counts = &self.counts[cell * texels..(cell + 1) * texels];
+                expected_rejection(counts, self.totals[cell], self.prior, cost_ratio)
+            })
+            .collect();
+        self.planned = Some(cost_ratio);
     }
 
     /// The cell `key`, if any ray was ever recorded there.
@@ -204,6 +229,9 @@ impl VisibilityField {
             counts: &self.counts[first as usize..first as usize + texels],
             total: self.totals[index],
             darkest: self.darkest[index],
+            planned: self
+                .planned
+                .map(|ratio| (ratio, self.expected_rejection[index])),
             side: self.side,
             prior: self.prior,
         })
@@ -216,6 +244,9 @@ impl VisibilityField {
             "observations of another map size"
         );
         let texels = (self.side * self.side) as usize;
+        if !observations.cells.is_empty() {
+            self.planned = None;
+        }
         for (key, seen) in &observations.cells {
             let next = self.counts.len() as u32;
             let first = *self.cells.entry(*key).or_insert_with(|| next) as usize;
@@ -248,6 +279,31 @@ pub const LOWEST_ACCEPTANCE: f32 = 0.1;
 /// A cell with fewer traced rays than this is not trusted yet: its gathers trace every
 /// candidate.
 pub const LEAST_EVIDENCE: u32 = 32;
+
+/// A gather rolls only where roulette is expected to skip at least this share of its
+/// candidates. Below it, looking up a texel for every candidate costs more than the few
+/// skipped rays save (a lookup costs about a tenth of a traced candidate).
+pub const WORTH_REJECTING: f32 = 0.1;
+
+/// The share of a cell's candidates that roulette at `cost_ratio` skips, estimated from
+/// where its traced rays went: Σ over texels of (rays there / rays) · (1 − acceptance).
+pub fn expected_rejection(
+    counts: &[TexelCounts],
+    total: TexelCounts,
+    prior: f32,
+    cost_ratio: f32,
+) -> f32 {
+    if total.traced == 0 {
+        return 0.0;
+    }
+    let cell = visibility(total, prior);
+    let skipped: f32 = counts
+        .iter()
+        .filter(|c| c.traced > 0)
+        .map(|&c| c.traced as f32 * (1.0 - acceptance(visibility(c, prior), cell, cost_ratio)))
+        .sum();
+    skipped / total.traced as f32
+}
 
 /// The visibility of counts with `prior` free pseudo-observations (1 with no evidence).
 #[inline]
@@ -283,6 +339,8 @@ pub struct FieldCell<'a> {
     total: TexelCounts,
     /// The lowest visibility of its texels.
     darkest: f32,
+    /// The planned cost ratio and this cell's expected rejection at it.
+    planned: Option<(f32, f32)>,
     side: u32,
     prior: f32,
 }
@@ -305,10 +363,21 @@ impl FieldCell<'_> {
     }
 
     /// Whether roulette can pay here at this cost ratio: the cell has [`LEAST_EVIDENCE`]
-    /// rays, and a texel dark enough that [`acceptance`] is below 1 there. Elsewhere a
-    /// gather should trace every candidate and do no map work.
+    /// rays, and roulette would skip at least [`WORTH_REJECTING`] of its candidates.
+    /// Elsewhere a gather should trace every candidate and do no map work.
     pub fn worth_rolling(&self, cost_ratio: f32) -> bool {
-        self.total.traced >= LEAST_EVIDENCE && (1.0 + cost_ratio) * self.darkest < self.visibility()
+        self.total.traced >= LEAST_EVIDENCE
+            && (1.0 + cost_ratio) * self.darkest < self.visibility()
+            && self.expected_rejection(cost_ratio) >= WORTH_REJECTING
+    }
+
+    /// The share of this cell's candidates that roulette at `cost_ratio` skips (see
+    /// [`expected_rejection`]); read from the field's plan when it was made for this ratio.
+    pub fn expected_rejection(&self, cost_ratio: f32) -> f32 {
+        match self.planned {
+            Some((ratio, share)) if ratio == cost_ratio => share,
+            _ => expected_rejection(self.counts, self.total, self.prior, cost_ratio),
+        }
     }
 
     /// [`acceptance`] toward `direction`.
@@ -497,6 +566,44 @@ mod tests {
         assert!((cell.acceptance([-1.0, 0.0, 0.0], 1.0) - expected).abs() < 1e-6);
         assert_eq!(cell.acceptance([0.0, 1.0, 0.0], 1.0), 1.0);
         assert!(!cell.worth_rolling(40.0), "rays too cheap to skip");
+    }
+
+    #[test]
+    fn a_cell_rolls_only_where_roulette_skips_enough() {
+        let key = CellKey::new([0.0; 3], [0.0, 1.0, 0.0], 0);
+        let field_with = |blocked_share: u32| {
+            let mut observed = FieldObservations::new(4);
+            for k in 0..1000 {
+                let blocked = k % 100 < blocked_share;
+                let direction = if blocked { [-1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+                observed.record(key, direction, !blocked);
+            }
+            let mut field = VisibilityField::new(4);
+            field.merge(&observed);
+            field
+        };
+        // 1% of the rays go to a blocked texel: roulette would skip about 1% of candidates.
+        let rare = field_with(1);
+        let cell = rare.cell(&key).unwrap();
+        assert!(cell.expected_rejection(1.0) < 0.02);
+        assert!(!cell.worth_rolling(1.0), "too little to skip for the map work");
+        // 40%: at ρ = 1 a blocked texel is accepted with √(2 · (2/402) / (602/1002)) ≈ 0.13.
+        let mut field = field_with(40);
+        let unplanned = field.cell(&key).unwrap().expected_rejection(1.0);
+        let a = (2.0f32 * (2.0 / 402.0) / (602.0 / 1002.0)).sqrt();
+        assert!((unplanned - 0.4 * (1.0 - a)).abs() < 1e-5);
+        assert!(field.cell(&key).unwrap().worth_rolling(1.0));
+        // A plan gives the same share without a pass over the texels.
+        field.plan(1.0);
+        let cell = field.cell(&key).unwrap();
+        assert_eq!(cell.planned, Some((1.0, unplanned)));
+        assert_eq!(cell.expected_rejection(1.0), unplanned);
+        assert!(cell.expected_rejection(4.0) < unplanned, "another ratio is worked out");
+        // A merge makes the plan stale.
+        let mut more = FieldObservations::new(4);
+        more.record(key, [0.0, 1.0, 0.0], true);
+        field.merge(&more);
+        assert_eq!(field.cell(&key).unwrap().planned, None);
     }
 
     #[test]

@@ -99,6 +99,8 @@ pub struct GatherLearning {
     pub field: Arc<VisibilityField>,
     /// The timings of every pass so far.
     pub cost: CostSample,
+    /// The settings' `cost_ratio`, if pinned.
+    pinned_cost_ratio: Option<f32>,
 }
 
 impl GatherLearning {
@@ -108,14 +110,14 @@ impl GatherLearning {
         GatherLearning {
             field: Arc::new(field),
             cost: CostSample::default(),
+            pinned_cost_ratio: settings.cost_ratio,
         }
     }
 
     /// The cost ratio the next pass uses: the settings' `cost_ratio` if given, else the one
     /// measured so far.
-    pub fn cost_ratio(&self, settings: &GatherSettings) -> f32 {
-        settings
-            .cost_ratio
+    pub fn cost_ratio(&self) -> f32 {
+        self.pinned_cost_ratio
             .or_else(|| self.cost.ratio())
             .unwrap_or(UNMEASURED_COST_RATIO)
     }
@@ -130,6 +132,12 @@ impl Learning for GatherLearning {
             Arc::make_mut(&mut self.field).merge(&pass.observations);
             self.cost.add(pass.cost);
         }
+    }
+
+    /// Plans the next pass's roulette at its cost ratio: which cells it pays in.
+    fn end_pass(&mut self) {
+        let cost_ratio = self.cost_ratio();
+        Arc::make_mut(&mut self.field).plan(cost_ratio);
     }
 }
 

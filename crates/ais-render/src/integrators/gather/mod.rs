@@ -119,7 +119,7 @@ impl<P: BatchProbe> GatherTile<P> {
             field: learning.field.clone(),
             observations: field.then(|| FieldObservations::new(learning.field.side())),
             field_gathers: [0; 2],
-            cost_ratio: learning.cost_ratio(settings),
+            cost_ratio: learning.cost_ratio(),
             cost: CostSample::default(),
             gathers: 0,
             probe,
