@@ -125,7 +125,7 @@ pub fn render<I: SampleIntegrator>(
     settings: &RenderSettings,
 ) -> RenderOutput<<I::Tile as TileState>::Stats> {
     let mut learned = integrator.new_learning();
-    render_learning(world, integrator, settings, &mut learned)
+    render_passes(world, integrator, settings, &mut learned, false)
 }
 
 /// [`render`], starting from what earlier renders of the same scene learned (`learned`)
@@ -135,6 +135,18 @@ pub fn render_learning<I: SampleIntegrator>(
     integrator: &I,
     settings: &RenderSettings,
     learned: &mut I::Learned,
+) -> RenderOutput<<I::Tile as TileState>::Stats> {
+    render_passes(world, integrator, settings, learned, true)
+}
+
+/// The passes of a render; what the last one observes is recorded only if
+/// `learning_goes_on` (later renders use it).
+fn render_passes<I: SampleIntegrator>(
+    world: &World,
+    integrator: &I,
+    settings: &RenderSettings,
+    learned: &mut I::Learned,
+    learning_goes_on: bool,
 ) -> RenderOutput<<I::Tile as TileState>::Stats> {
     let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
     let region = settings.crop.unwrap_or(PixelRect::whole(width, height));
@@ -158,6 +170,7 @@ pub fn render_learning<I: SampleIntegrator>(
                     rect,
                     image: (width, height),
                     seed: settings.seed,
+                    learns: learning_goes_on || index + 1 < passes.len(),
                 };
                 let result = render_tile(world, integrator, learned, pass, &tile);
                 progress.inc(1);

@@ -92,6 +92,9 @@ pub struct Tile {
     pub image: (usize, usize),
     /// The render's base seed.
     pub seed: u64,
+    /// Whether what this pass observes is used afterwards (false in the last pass of a
+    /// render whose learning ends with it): an integrator may skip recording it.
+    pub learns: bool,
 }
 
 /// The tiles of a `width × height` image, row by row.

@@ -126,6 +126,10 @@ impl Hasher for KeyHasher {
 
 type KeyMap<V> = HashMap<CellKey, V, BuildHasherDefault<KeyHasher>>;
 
+/// Where a cell's counts lie in a [`VisibilityField`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CellIndex(u32);
+
 /// The learned field: every cell seen so far and its texels' counts.
 #[derive(Clone, Debug)]
 pub struct VisibilityField {
@@ -222,10 +226,24 @@ impl VisibilityField {
     /// The cell `key`, if any ray was ever recorded there.
     #[inline]
     pub fn cell(&self, key: &CellKey) -> Option<FieldCell<'_>> {
-        let &first = self.cells.get(key)?;
+        self.find(key).map(|index| self.cell_at(index))
+    }
+
+    /// Where the cell `key` is, if any ray was ever recorded there: one hash probe, whose
+    /// answer a host may keep for the next gathers in the same cell while the field is
+    /// unchanged (a pass).
+    #[inline]
+    pub fn find(&self, key: &CellKey) -> Option<CellIndex> {
+        self.cells.get(key).map(|&first| CellIndex(first))
+    }
+
+    /// The cell at `index` (from [`VisibilityField::find`] on this field since its last
+    /// merge).
+    #[inline]
+    pub fn cell_at(&self, CellIndex(first): CellIndex) -> FieldCell<'_> {
         let texels = (self.side * self.side) as usize;
         let index = first as usize / texels;
-        Some(FieldCell {
+        FieldCell {
             counts: &self.counts[first as usize..first as usize + texels],
             total: self.totals[index],
             darkest: self.darkest[index],
@@ -234,7 +252,7 @@ impl VisibilityField {
                 .map(|ratio| (ratio, self.expected_rejection[index])),
             side: self.side,
             prior: self.prior,
-        })
+        }
     }
 
     /// Adds what a tile observed (observations made with another `side` are refused).
@@ -575,7 +593,11 @@ mod tests {
             let mut observed = FieldObservations::new(4);
             for k in 0..1000 {
                 let blocked = k % 100 < blocked_share;
-                let direction = if blocked { [-1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+                let direction = if blocked {
+                    [-1.0, 0.0, 0.0]
+                } else {
+                    [0.0, 1.0, 0.0]
+                };
                 observed.record(key, direction, !blocked);
             }
             let mut field = VisibilityField::new(4);
@@ -586,7 +608,10 @@ mod tests {
         let rare = field_with(1);
         let cell = rare.cell(&key).unwrap();
         assert!(cell.expected_rejection(1.0) < 0.02);
-        assert!(!cell.worth_rolling(1.0), "too little to skip for the map work");
+        assert!(
+            !cell.worth_rolling(1.0),
+            "too little to skip for the map work"
+        );
         // 40%: at ρ = 1 a blocked texel is accepted with √(2 · (2/402) / (602/1002)) ≈ 0.13.
         let mut field = field_with(40);
         let unplanned = field.cell(&key).unwrap().expected_rejection(1.0);
@@ -598,7 +623,10 @@ mod tests {
         let cell = field.cell(&key).unwrap();
         assert_eq!(cell.planned, Some((1.0, unplanned)));
         assert_eq!(cell.expected_rejection(1.0), unplanned);
-        assert!(cell.expected_rejection(4.0) < unplanned, "another ratio is worked out");
+        assert!(
+            cell.expected_rejection(4.0) < unplanned,
+            "another ratio is worked out"
+        );
         // A merge makes the plan stale.
         let mut more = FieldObservations::new(4);
         more.record(key, [0.0, 1.0, 0.0], true);

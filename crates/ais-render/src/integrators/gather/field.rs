@@ -189,6 +189,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         field,
         observations,
         field_gathers,
+        last_cell,
         cost_ratio,
         cost,
         gathers,
@@ -196,14 +197,24 @@ pub(super) fn field_gather<P: BatchProbe>(
         ..
     } = state;
     let cost_ratio = *cost_ratio;
-    let known = field.cell(&site.key);
+    let index = match *last_cell {
+        Some((key, index)) if key == site.key => index,
+        _ => {
+            let index = field.find(&site.key);
+            *last_cell = Some((site.key, index));
+            index
+        }
+    };
+    let known = index.map(|index| field.cell_at(index));
     let record = known.is_none_or(|cell| cell.total().traced < WELL_KNOWN)
         || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN);
     let cell = known.filter(|cell| cell.worth_rolling(cost_ratio));
     field_gathers[usize::from(cell.is_none())] += 1;
     *gathers += 1;
     let clock = Cell::new(Duration::ZERO);
-    let timed = settings.cost_ratio.is_none() && gathers.is_multiple_of(TIMED_ONE_IN);
+    let timed = observations.is_some()
+        && settings.cost_ratio.is_none()
+        && gathers.is_multiple_of(TIMED_ONE_IN);
     let sampler = CandidateSampler::plain(settings.strategy);
     let run = BatchRun {
         world,
@@ -221,9 +232,9 @@ pub(super) fn field_gather<P: BatchProbe>(
         .as_mut()
         .filter(|_| record)
         .map(|observations| observations.cell_mut(site.key));
-    let started = Instant::now();
+    let started = timed.then(Instant::now);
     let value = run_batch(&run, batch, counts, probe, recorder.as_mut());
-    if timed {
+    if let Some(started) = started {
         let after = batch.stats();
         cost.add(CostSample {
             gathers: started.elapsed(),

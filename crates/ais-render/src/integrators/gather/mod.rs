@@ -29,7 +29,7 @@ pub use strategy::{gather_point, GatherPoint, Strategy};
 use crate::geometry::{Hit, Ray};
 use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
-use ais::field::{FieldObservations, VisibilityField};
+use ais::field::{CellIndex, CellKey, FieldObservations, VisibilityField};
 use ais::rng::Pcg32;
 use ais::shared::{blend_neighbours, NeighbourSource, RecentGathers};
 use ais::{AffinityMap, Batch, MapStart};
@@ -89,6 +89,9 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) observations: Option<FieldObservations>,
     /// Gathers that used the field, and gathers where it stood aside.
     pub(super) field_gathers: [u64; 2],
+    /// The last cell looked up in the field, and where it is: neighbouring pixels often
+    /// share a cell.
+    pub(super) last_cell: Option<(CellKey, Option<CellIndex>)>,
     /// The cost ratio the field's acceptance uses in this pass.
     pub(super) cost_ratio: f32,
     /// This pass's timings of sampled gathers, for the next pass's cost ratio.
@@ -117,8 +120,11 @@ impl<P: BatchProbe> GatherTile<P> {
             learned: LearningPass::default(),
             guide: None,
             field: learning.field.clone(),
-            observations: field.then(|| FieldObservations::new(learning.field.side())),
+            // What the last pass of a render observes would never be used.
+            observations: (field && tile.learns)
+                .then(|| FieldObservations::new(learning.field.side())),
             field_gathers: [0; 2],
+            last_cell: None,
             cost_ratio: learning.cost_ratio(),
             cost: CostSample::default(),
             gathers: 0,
