@@ -29,6 +29,12 @@ pub trait Learning: Sync {
 
     /// Called once a pass's observations are all merged, before the next pass starts.
     fn end_pass(&mut self) {}
+
+    /// Whether more learning passes can pay (asked after [`Learning::end_pass`]); if not,
+    /// the render's remaining samples run as one last pass.
+    fn keeps_learning(&self) -> bool {
+        true
+    }
 }
 
 impl Learning for () {

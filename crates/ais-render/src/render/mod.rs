@@ -154,11 +154,13 @@ fn render_passes<I: SampleIntegrator>(
         .iter()
         .filter_map(|tile| tile.intersection(&region))
         .collect();
-    let passes = integrator.passes(settings.samples_per_pixel);
+    let mut passes = integrator.passes(settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
     let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(region);
-    for (index, &samples) in passes.iter().enumerate() {
+    let mut index = 0;
+    while index < passes.len() {
+        let samples = passes[index];
         let pass = Pass {
             index: index as u64,
             samples,
@@ -181,6 +183,14 @@ fn render_passes<I: SampleIntegrator>(
             learned.merge(output.add(result, samples, settings.samples_per_pixel));
         }
         learned.end_pass();
+        if index + 2 < passes.len() && !learned.keeps_learning() {
+            // Learning cannot pay: the remaining samples in one last pass.
+            let rest = passes[index + 1..].iter().sum();
+            passes.truncate(index + 1);
+            passes.push(rest);
+            progress.set_length((rects.len() * passes.len()) as u64);
+        }
+        index += 1;
     }
     progress.finish_and_clear();
     RenderOutput {

@@ -223,6 +223,28 @@ impl VisibilityField {
         self.planned = Some(cost_ratio);
     }
 
+    /// After [`VisibilityField::plan`]: the share of the rays recorded so far whose cells
+    /// roulette pays in at the planned ratio ([`FieldCell::worth_rolling`]), or `None`
+    /// while less than half of them lie in cells with [`LEAST_EVIDENCE`] (too early to
+    /// tell). A host may stop learning where the share is small: the field would stand
+    /// aside nearly everywhere.
+    pub fn rolling_share(&self) -> Option<f32> {
+        let cost_ratio = self.planned?;
+        let (mut all, mut known, mut rolling) = (0u64, 0u64, 0u64);
+        for (index, total) in self.totals.iter().enumerate() {
+            let rays = u64::from(total.traced);
+            all += rays;
+            if total.traced >= LEAST_EVIDENCE {
+                known += rays;
+                let cell = self.cell_at(CellIndex((index * (self.side * self.side) as usize) as u32));
+                if cell.worth_rolling(cost_ratio) {
+                    rolling += rays;
+                }
+            }
+        }
+        (all > 0 && 2 * known >= all).then(|| rolling as f32 / all as f32)
+    }
+
     /// The cell `key`, if any ray was ever recorded there.
     #[inline]
     pub fn cell(&self, key: &CellKey) -> Option<FieldCell<'_>> {

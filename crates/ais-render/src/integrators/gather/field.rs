@@ -39,6 +39,9 @@ pub fn field_passes(spp: u32) -> Vec<u32> {
     passes
 }
 
+/// Learning stops once fewer than this share of the rays fall in cells where roulette pays.
+pub const LEAST_ROLLING_SHARE: f32 = 0.05;
+
 /// A cell with this many rays in the field learns from one gather in
 /// [`WELL_KNOWN_RECORD_ONE_IN`] only: recording costs time, and it knows enough.
 pub const WELL_KNOWN: u32 = 512;
@@ -138,6 +141,14 @@ impl Learning for GatherLearning {
     fn end_pass(&mut self) {
         let cost_ratio = self.cost_ratio();
         Arc::make_mut(&mut self.field).plan(cost_ratio);
+    }
+
+    /// Learning goes on unless the field, with enough evidence, stands aside for nearly
+    /// every ray (the talk's auto-disable): then the rest of the render is one pass.
+    fn keeps_learning(&self) -> bool {
+        self.field
+            .rolling_share()
+            .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
     }
 }
 
