@@ -236,7 +236,8 @@ impl VisibilityField {
             all += rays;
             if total.traced >= LEAST_EVIDENCE {
                 known += rays;
-                let cell = self.cell_at(CellIndex((index * (self.side * self.side) as usize) as u32));
+                let cell =
+                    self.cell_at(CellIndex((index * (self.side * self.side) as usize) as u32));
                 if cell.worth_rolling(cost_ratio) {
                     rolling += rays;
                 }
@@ -654,6 +655,37 @@ mod tests {
         more.record(key, [0.0, 1.0, 0.0], true);
         field.merge(&more);
         assert_eq!(field.cell(&key).unwrap().planned, None);
+    }
+
+    #[test]
+    fn the_rolling_share_says_when_learning_can_stop() {
+        let mut field = VisibilityField::new(4);
+        assert_eq!(field.rolling_share(), None, "nothing planned");
+        let dark = CellKey::new([0.0; 3], [0.0, 1.0, 0.0], 0);
+        let open = CellKey::new([9.0; 3], [0.0, 1.0, 0.0], 0);
+        let mut observed = FieldObservations::new(4);
+        for k in 0..10 {
+            // Too few rays in the dark cell to judge it.
+            observed.record(dark, [-1.0, 0.0, 0.0], false);
+            observed.record(dark, [0.0, 1.0, 0.0], k % 2 == 0);
+        }
+        for _ in 0..10 {
+            observed.record(open, [0.0, 1.0, 0.0], true);
+        }
+        field.merge(&observed);
+        field.plan(1.0);
+        assert_eq!(field.rolling_share(), None, "too early to tell");
+        let mut more = FieldObservations::new(4);
+        for k in 0..200 {
+            more.record(dark, [-1.0, 0.0, 0.0], false);
+            more.record(dark, [0.0, 1.0, 0.0], k % 2 == 0);
+            more.record(open, [0.0, 1.0, 0.0], true);
+        }
+        field.merge(&more);
+        field.plan(1.0);
+        // The dark cell (420 of 630 rays) rolls; the open one does not.
+        let share = field.rolling_share().unwrap();
+        assert!((share - 2.0 / 3.0).abs() < 1e-6, "{share}");
     }
 
     #[test]
