@@ -243,18 +243,14 @@ pub fn emitting_triangles(mesh: &TriangleMesh, flip_normals: bool) -> Vec<Triang
         .collect()
 }
 
-/// An rgb or float radiance property, which must be finite and non-negative.
+/// An rgb or float radiance property, which must be finite and non-negative; Mitsuba's
+/// default of 1 where it is not given.
 fn radiance_property(file: &Path, plugin: &Plugin, name: &str) -> Result<Vec3, InputError> {
     let value = match plugin.properties.get(name).map(|p| &p.value) {
         Some(Property::Rgb(c)) => Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32),
         Some(Property::Float(v)) => Vec3::splat(*v as f32),
-        None => {
-            return Err(InputError::at(
-                file,
-                plugin.line,
-                format!("{} emitter needs \"{name}\"", plugin.kind),
-            ))
-        }
+        // Mitsuba's default radiance, for area and constant emitters alike.
+        None => Vec3::ONE,
         Some(other) => {
             return Err(InputError::at(
                 file,
