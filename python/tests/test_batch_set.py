@@ -72,7 +72,7 @@ def test_bad_arguments_are_refused():
     batches.begin(8, 0)
     batches.next_candidates()
     with pytest.raises(ValueError, match="directions has 2 rows"):
-        batches.decide(np.zeros((2, 3)), np.ones(2, dtype=bool))
+        batches.decide(np.zeros((2, 3)), np.ones(4, dtype=bool))
     with pytest.raises(ValueError, match="finish"):
         batches.finish()
     trace, _ = batches.decide(np.tile([0.0, 0.0, 1.0], (4, 1)), np.ones(4, dtype=bool))

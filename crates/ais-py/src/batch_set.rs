@@ -7,7 +7,7 @@ use crate::errors::argument_error;
 use crate::options::parameter_text;
 use ais::{BatchConfig, BatchSet, Round};
 use ais_render::integrators::gather::{GatherSettings, MapSource};
-use numpy::ndarray::{Array1, Array2};
+use numpy::ndarray::{Array1, Array2, ArrayView2};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -60,6 +60,33 @@ fn batch_config(options: Option<&Bound<'_, PyDict>>) -> PyResult<BatchConfig> {
         ));
     }
     Ok(settings.batch_config())
+}
+
+/// Hands each gather's row of `rows` (one row of 3 per gather, checked) to `set`, with
+/// the gather's chunk round, index in the chunk and index in the set.
+fn scatter(
+    chunks: &mut [Chunk],
+    name: &str,
+    rows: ArrayView2<'_, f32>,
+    mut set: impl FnMut(&mut Round<[f32; 3]>, usize, [f32; 3], usize),
+) -> PyResult<()> {
+    let gathers: usize = chunks.iter().map(|c| c.set.len()).sum();
+    check_rows(name, rows.nrows(), gathers)?;
+    if rows.ncols() != 3 {
+        return Err(argument_error(format!("{name} must have 3 columns")));
+    }
+    for chunk in chunks.iter_mut() {
+        for g in 0..chunk.set.len() {
+            let row = rows.row(chunk.start + g);
+            set(
+                &mut chunk.round,
+                g,
+                [row[0], row[1], row[2]],
+                chunk.start + g,
+            );
+        }
+    }
+    Ok(())
 }
 
 /// Checks that an array has one row per gather.
@@ -142,23 +169,21 @@ impl PyBatchSet {
         acceptance: Option<PyReadonlyArray1<'_, f32>>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyAny>)> {
         let (directions, in_support) = (directions.as_array(), in_support.as_array());
-        check_rows("directions", directions.nrows(), self.gathers)?;
         check_rows("in_support", in_support.len(), self.gathers)?;
         let acceptance = acceptance.map(|a| a.as_array().to_vec());
         if let Some(acceptance) = &acceptance {
             check_rows("acceptance", acceptance.len(), self.gathers)?;
         }
-        if directions.ncols() != 3 {
-            return Err(argument_error("directions must have 3 columns"));
-        }
         let mut chunks = self.lock();
-        for chunk in chunks.iter_mut() {
-            for g in 0..chunk.set.len() {
-                let row = directions.row(chunk.start + g);
-                chunk.round.directions[g] = [row[0], row[1], row[2]];
-                chunk.round.in_support[g] = in_support[chunk.start + g];
-            }
-        }
+        scatter(
+            &mut chunks,
+            "directions",
+            directions,
+            |round, g, row, global| {
+                round.directions[g] = row;
+                round.in_support[g] = in_support[global];
+            },
+        )?;
         let all: &mut [Chunk] = &mut chunks;
         py.detach(|| {
             all.par_iter_mut().for_each(|c| match &acceptance {
@@ -184,19 +209,17 @@ impl PyBatchSet {
         ratings: PyReadonlyArray1<'_, f32>,
     ) -> PyResult<()> {
         let (contributions, ratings) = (contributions.as_array(), ratings.as_array());
-        check_rows("contributions", contributions.nrows(), self.gathers)?;
         check_rows("ratings", ratings.len(), self.gathers)?;
-        if contributions.ncols() != 3 {
-            return Err(argument_error("contributions must have 3 columns (RGB)"));
-        }
         let mut chunks = self.lock();
-        for chunk in chunks.iter_mut() {
-            for g in 0..chunk.set.len() {
-                let row = contributions.row(chunk.start + g);
-                chunk.round.contributions[g] = [row[0], row[1], row[2]];
-                chunk.round.ratings[g] = ratings[chunk.start + g];
-            }
-        }
+        scatter(
+            &mut chunks,
+            "contributions",
+            contributions,
+            |round, g, row, global| {
+                round.contributions[g] = row;
+                round.ratings[g] = ratings[global];
+            },
+        )?;
         let all: &mut [Chunk] = &mut chunks;
         py.detach(|| all.par_iter_mut().for_each(|c| c.set.record(&c.round)));
         Ok(())

@@ -9,7 +9,7 @@ use super::{batch_for, GatherSettings, GatherTile};
 use crate::geometry::Hit;
 use crate::render::{Learning, RayCounts};
 use crate::world::World;
-use ais::field::{CellKey, FieldObservations, VisibilityField};
+use ais::field::{CellIndex, CellKey, FieldCell, FieldObservations, VisibilityField};
 use ais::MapStart;
 use glam::Vec3;
 use std::cell::Cell;
@@ -184,6 +184,24 @@ impl<'a> FieldSite<'a> {
     }
 }
 
+/// The cell `key` of `field`, remembering where it was in `last_cell`: neighbouring pixels
+/// often share a cell, and the field does not change within a pass.
+fn find_cell<'f>(
+    field: &'f VisibilityField,
+    last_cell: &mut Option<(CellKey, Option<CellIndex>)>,
+    key: CellKey,
+) -> Option<FieldCell<'f>> {
+    let index = match *last_cell {
+        Some((last, index)) if last == key => index,
+        _ => {
+            let index = field.find(&key);
+            *last_cell = Some((key, index));
+            index
+        }
+    };
+    index.map(|index| field.cell_at(index))
+}
+
 /// A gather with acceptance from the learned field: roulette where the field's cell says it
 /// pays at this render's cost ratio, every candidate traced (and no map work) elsewhere. Its
 /// traced rays are recorded for the next pass's field; one gather in [`TIMED_ONE_IN`] is
@@ -208,15 +226,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         ..
     } = state;
     let cost_ratio = *cost_ratio;
-    let index = match *last_cell {
-        Some((key, index)) if key == site.key => index,
-        _ => {
-            let index = field.find(&site.key);
-            *last_cell = Some((site.key, index));
-            index
-        }
-    };
-    let known = index.map(|index| field.cell_at(index));
+    let known = find_cell(field, last_cell, site.key);
     let record = known.is_none_or(|cell| cell.total().traced < WELL_KNOWN)
         || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN);
     let cell = known.filter(|cell| cell.worth_rolling(cost_ratio));
