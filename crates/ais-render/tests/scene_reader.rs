@@ -178,7 +178,7 @@ fn every_error_names_file_line_and_problem() {
         ("<scene><shape type=\"cube\">\n<boolean name=\"flip_normals\" value=\"yes\"/></shape></scene>", "\"yes\" is not true or false"),
         ("<scene><sensor type=\"perspective\"><film type=\"hdrfilm\">\n<integer name=\"width\" value=\"1.5\"/></film></sensor></scene>", "test.xml:2: \"1.5\" is not an integer"),
         ("<scene><sensor type=\"perspective\"><film type=\"hdrfilm\">\n<integer name=\"width\" value=\"0\"/></film></sensor></scene>", "out of range"),
-        ("<scene><sensor type=\"orthographic\"/></scene>", "sensor type \"orthographic\" is not supported"),
+        ("<scene><sensor type=\"radiancemeter\"/></scene>", "sensor type \"radiancemeter\" is not supported"),
         ("<scene><sensor type=\"perspective\"><float name=\"fov\" value=\"200\"/></sensor></scene>", "fov must be in (0, 180)"),
         ("<scene><sensor type=\"perspective\"><string name=\"fov_axis\" value=\"z\"/></sensor></scene>", "unknown fov_axis"),
         ("<scene><sensor type=\"perspective\"><film type=\"ldrfilm\"/></sensor></scene>", "film type \"ldrfilm\" is not supported"),

@@ -22,14 +22,26 @@ pub enum FovAxis {
     Larger,
 }
 
-/// A perspective camera.
+/// How a camera projects the scene onto the film.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Projection {
+    /// A pinhole at the camera's origin (Mitsuba's `perspective`).
+    Perspective,
+    /// Parallel rays along the camera's +z from the rectangle [−1, 1] × [−1/aspect,
+    /// 1/aspect] of its xy plane, before `to_world` (Mitsuba's `orthographic`).
+    Orthographic,
+}
+
+/// A camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraDescription {
     /// Camera to world (Mitsuba's convention: +z forward, +y up, +x left).
     pub to_world: DMat4,
-    /// Field of view in degrees.
+    /// Perspective or orthographic.
+    pub projection: Projection,
+    /// Field of view in degrees (perspective).
     pub fov_degrees: f64,
-    /// The axis `fov_degrees` spans.
+    /// The axis `fov_degrees` spans (perspective).
     pub fov_axis: FovAxis,
 }
 
@@ -136,6 +148,7 @@ pub fn parse_scene(
         file: path.to_path_buf(),
         camera: CameraDescription {
             to_world: DMat4::IDENTITY,
+            projection: Projection::Perspective,
             fov_degrees: 39.3077,
             fov_axis: FovAxis::X,
         },
@@ -244,17 +257,31 @@ fn read_sensor(
     Ok(())
 }
 
-/// The camera of a `perspective` (or, as a pinhole, `thinlens`) sensor.
+/// The camera of a `perspective` (or, as a pinhole, `thinlens`) or `orthographic` sensor.
 fn read_camera(
     path: &Path,
     sensor: &Plugin,
     warnings: &mut Vec<String>,
 ) -> Result<CameraDescription, (u32, String)> {
+    if sensor.kind == "orthographic" {
+        warn_unknown(
+            path,
+            sensor,
+            &["to_world", "near_clip", "far_clip"],
+            warnings,
+        );
+        return Ok(CameraDescription {
+            to_world: sensor.transform("to_world")?,
+            projection: Projection::Orthographic,
+            fov_degrees: 0.0,
+            fov_axis: FovAxis::X,
+        });
+    }
     if sensor.kind != "perspective" && sensor.kind != "thinlens" {
         return Err((
             sensor.line,
             format!(
-                "sensor type \"{}\" is not supported (use perspective)",
+                "sensor type \"{}\" is not supported (perspective, orthographic)",
                 sensor.kind
             ),
         ));
@@ -283,6 +310,7 @@ fn read_camera(
     };
     let camera = CameraDescription {
         to_world: sensor.transform("to_world")?,
+        projection: Projection::Perspective,
         fov_degrees: fov,
         fov_axis,
     };

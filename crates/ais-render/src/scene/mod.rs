@@ -7,7 +7,7 @@ mod xml;
 
 pub(crate) use description::warn_unknown;
 pub use description::{
-    load_scene, parse_scene, CameraDescription, FovAxis, MeshFormat, SceneDescription,
+    load_scene, parse_scene, CameraDescription, FovAxis, MeshFormat, Projection, SceneDescription,
     ShapeDescription, ShapeGeometry,
 };
 pub use file_resolver::FileResolver;

@@ -286,7 +286,7 @@ pub fn gather<P: BatchProbe>(
         return emitted;
     }
     let at = gather_point(world, &hit, -ray.direction);
-    let footprint = hit.t * world.camera.pixel_angle(world.resolution.0);
+    let footprint = world.camera.footprint(hit.t, world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if settings.map == MapSource::Field {
         let site = field::FieldSite::new(&hit, &at, footprint, settings.field_cell, seed);
