@@ -14,6 +14,8 @@ pub struct Camera {
     /// perspective camera, half the width and height of the viewed rectangle (before
     /// `to_world`) for the orthographic one.
     half: (f32, f32),
+    /// A thin lens: its radius and the distance in focus (camera space).
+    lens: Option<(f32, f32)>,
 }
 
 /// tan(half field of view) along x and y of a perspective camera with this aspect.
@@ -48,7 +50,32 @@ impl Camera {
             to_world: description.to_world.as_mat4(),
             projection: description.projection,
             half: (half_x as f32, half_y as f32),
+            lens: description
+                .lens
+                .filter(|lens| lens.aperture_radius > 0.0)
+                .map(|lens| (lens.aperture_radius as f32, lens.focus_distance as f32)),
         }
+    }
+
+    /// Whether rays start anywhere on a lens (and need two more random numbers).
+    pub fn has_aperture(&self) -> bool {
+        self.lens.is_some()
+    }
+
+    /// [`Camera::ray`] from the point of the lens chosen by `lens_sample` ∈ [0, 1)²: the
+    /// rays through one film position all meet on the plane in focus.
+    pub fn ray_through_lens(&self, u: f32, v: f32, lens_sample: [f32; 2]) -> Ray {
+        let Some((radius, focus)) = self.lens else {
+            return self.ray(u, v);
+        };
+        let x = -(2.0 * u - 1.0) * self.half.0;
+        let y = -(2.0 * v - 1.0) * self.half.1;
+        let in_focus = Vec3::new(x, y, 1.0) * focus;
+        let [lx, ly] = ais::sampling::warp::uniform_disk(lens_sample);
+        let on_lens = Vec3::new(lx * radius, ly * radius, 0.0);
+        let origin = self.to_world.transform_point3(on_lens);
+        let direction = self.to_world.transform_vector3(in_focus - on_lens);
+        Ray::new(origin, direction.normalize())
     }
 
     /// The width of one pixel of a `width`-pixel-wide film at `distance` from the camera,
@@ -91,6 +118,7 @@ mod tests {
     fn centre_ray_looks_at_the_target_and_right_is_right() {
         let description = CameraDescription {
             projection: Projection::Perspective,
+            lens: None,
             to_world: look_at(DVec3::new(0.0, 0.0, 5.0), DVec3::ZERO, DVec3::Y).unwrap(),
             fov_degrees: 90.0,
             fov_axis: FovAxis::X,
@@ -115,6 +143,7 @@ mod tests {
             projection: Projection::Orthographic,
             fov_degrees: 0.0,
             fov_axis: FovAxis::X,
+            lens: None,
         };
         let camera = Camera::new(&description, 200, 100);
         let centre = camera.ray(0.5, 0.5);

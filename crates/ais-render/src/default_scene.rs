@@ -80,6 +80,7 @@ pub fn sculpture() -> TriangleMesh {
 pub fn default_camera() -> CameraDescription {
     CameraDescription {
         projection: crate::scene::Projection::Perspective,
+        lens: None,
         to_world: look_at(
             DVec3::new(3.3, 2.0, 5.0),
             DVec3::new(0.0, -0.25, 0.0),

@@ -179,6 +179,8 @@ fn every_error_names_file_line_and_problem() {
         ("<scene><sensor type=\"perspective\"><film type=\"hdrfilm\">\n<integer name=\"width\" value=\"1.5\"/></film></sensor></scene>", "test.xml:2: \"1.5\" is not an integer"),
         ("<scene><sensor type=\"perspective\"><film type=\"hdrfilm\">\n<integer name=\"width\" value=\"0\"/></film></sensor></scene>", "out of range"),
         ("<scene><sensor type=\"radiancemeter\"/></scene>", "sensor type \"radiancemeter\" is not supported"),
+        ("<scene><sensor type=\"thinlens\"/></scene>", "a thinlens sensor needs \"aperture_radius\""),
+        ("<scene><sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/><float name=\"focus_distance\" value=\"0\"/></sensor></scene>", "focus_distance must be positive"),
         ("<scene><sensor type=\"perspective\"><float name=\"fov\" value=\"200\"/></sensor></scene>", "fov must be in (0, 180)"),
         ("<scene><sensor type=\"perspective\"><string name=\"fov_axis\" value=\"z\"/></sensor></scene>", "unknown fov_axis"),
         ("<scene><sensor type=\"perspective\"><film type=\"ldrfilm\"/></sensor></scene>", "film type \"ldrfilm\" is not supported"),

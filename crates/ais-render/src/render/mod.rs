@@ -264,7 +264,13 @@ fn render_tile<I: SampleIntegrator>(
         for _ in 0..spp {
             let u = (x as f32 + rng.next_f32()) / width as f32;
             let v = (y as f32 + rng.next_f32()) / height as f32;
-            let ray = world.camera.ray(u, v);
+            let ray = if world.camera.has_aperture() {
+                world
+                    .camera
+                    .ray_through_lens(u, v, [rng.next_f32(), rng.next_f32()])
+            } else {
+                world.camera.ray(u, v)
+            };
             let value = integrator.radiance(world, &ray, &mut rng, &mut state, &mut counts);
             for (s, c) in sum.iter_mut().zip(value) {
                 *s += c as f64;

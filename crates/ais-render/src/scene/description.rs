@@ -32,6 +32,15 @@ pub enum Projection {
     Orthographic,
 }
 
+/// A thin lens in front of a perspective camera (Mitsuba's `thinlens`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLens {
+    /// The lens's radius, in world units.
+    pub aperture_radius: f64,
+    /// The distance of the plane in focus.
+    pub focus_distance: f64,
+}
+
 /// A camera.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraDescription {
@@ -43,6 +52,8 @@ pub struct CameraDescription {
     pub fov_degrees: f64,
     /// The axis `fov_degrees` spans (perspective).
     pub fov_axis: FovAxis,
+    /// A thin lens (perspective; None: a pinhole).
+    pub lens: Option<ThinLens>,
 }
 
 /// The mesh file formats.
@@ -149,6 +160,7 @@ pub fn parse_scene(
         camera: CameraDescription {
             to_world: DMat4::IDENTITY,
             projection: Projection::Perspective,
+            lens: None,
             fov_degrees: 39.3077,
             fov_axis: FovAxis::X,
         },
@@ -275,6 +287,7 @@ fn read_camera(
             projection: Projection::Orthographic,
             fov_degrees: 0.0,
             fov_axis: FovAxis::X,
+            lens: None,
         });
     }
     if sensor.kind != "perspective" && sensor.kind != "thinlens" {
@@ -286,13 +299,9 @@ fn read_camera(
             ),
         ));
     }
-    if sensor.kind == "thinlens" {
-        warnings.push(format!(
-            "{}:{}: thinlens sensor rendered as a pinhole (perspective)",
-            path.display(),
-            sensor.line
-        ));
-    }
+    let lens = (sensor.kind == "thinlens")
+        .then(|| read_lens(sensor))
+        .transpose()?;
     let fov = sensor.float("fov", 39.3077)?;
     if !(fov > 0.0 && fov < 180.0) {
         return Err((
@@ -311,6 +320,7 @@ fn read_camera(
     let camera = CameraDescription {
         to_world: sensor.transform("to_world")?,
         projection: Projection::Perspective,
+        lens,
         fov_degrees: fov,
         fov_axis,
     };
@@ -326,6 +336,29 @@ fn read_camera(
     ];
     warn_unknown(path, sensor, &KNOWN, warnings);
     Ok(camera)
+}
+
+/// A `thinlens` sensor's lens: `aperture_radius` (required, as in Mitsuba) and
+/// `focus_distance` (Mitsuba's default, 10,000).
+fn read_lens(sensor: &Plugin) -> Result<ThinLens, (u32, String)> {
+    if !sensor.properties.contains_key("aperture_radius") {
+        return Err((
+            sensor.line,
+            "a thinlens sensor needs \"aperture_radius\"".into(),
+        ));
+    }
+    let aperture_radius = sensor.float("aperture_radius", 0.0)?;
+    let focus_distance = sensor.float("focus_distance", 10_000.0)?;
+    if !(aperture_radius.is_finite() && aperture_radius >= 0.0) {
+        return Err((sensor.line, "aperture_radius must be finite and ≥ 0".into()));
+    }
+    if !(focus_distance.is_finite() && focus_distance > 0.0) {
+        return Err((sensor.line, "focus_distance must be positive".into()));
+    }
+    Ok(ThinLens {
+        aperture_radius,
+        focus_distance,
+    })
 }
 
 /// The size of an `hdrfilm`; its reconstruction filter is replaced by a box (with a

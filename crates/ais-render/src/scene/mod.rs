@@ -8,7 +8,7 @@ mod xml;
 pub(crate) use description::warn_unknown;
 pub use description::{
     load_scene, parse_scene, CameraDescription, FovAxis, MeshFormat, Projection, SceneDescription,
-    ShapeDescription, ShapeGeometry,
+    ShapeDescription, ShapeGeometry, ThinLens,
 };
 pub use file_resolver::FileResolver;
 pub use properties::{LocatedProperty, Plugin, Property};

@@ -24,13 +24,20 @@ pub fn uniform_sphere_invert(direction: Vec3) -> [f32; 2] {
     [(1.0 - direction.z) * 0.5, azimuth_fraction(direction)]
 }
 
-/// A cosine-weighted direction around +z (density [`cosine_hemisphere_pdf`]), in local
-/// coordinates.
+/// A uniform point of the unit disk (density 1/π), by polar coordinates.
 #[inline]
-pub fn cosine_hemisphere(u: [f32; 2]) -> Vec3 {
+pub fn uniform_disk(u: [f32; 2]) -> [f32; 2] {
     let r = u[0].sqrt();
     let phi = TAU * u[1];
-    Vec3::new(r * phi.cos(), r * phi.sin(), (1.0 - u[0]).max(0.0).sqrt())
+    [r * phi.cos(), r * phi.sin()]
+}
+
+/// A cosine-weighted direction around +z (density [`cosine_hemisphere_pdf`]), in local
+/// coordinates: a uniform point of the disk, lifted to the hemisphere.
+#[inline]
+pub fn cosine_hemisphere(u: [f32; 2]) -> Vec3 {
+    let [x, y] = uniform_disk(u);
+    Vec3::new(x, y, (1.0 - u[0]).max(0.0).sqrt())
 }
 
 /// The density of [`cosine_hemisphere`] at a local direction, cos θ / π (0 below).
