@@ -269,7 +269,27 @@ fn read_sensor(
     Ok(())
 }
 
-/// The camera of a `perspective` (or, as a pinhole, `thinlens`) or `orthographic` sensor.
+/// A perspective sensor's `fov` (Mitsuba's default, 39.3077°) and `fov_axis`.
+fn read_fov(sensor: &Plugin) -> Result<(f64, FovAxis), (u32, String)> {
+    let fov = sensor.float("fov", 39.3077)?;
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err((
+            sensor.line,
+            format!("fov must be in (0, 180) degrees, got {fov}"),
+        ));
+    }
+    let fov_axis = match sensor.string("fov_axis")?.unwrap_or("x") {
+        "x" => FovAxis::X,
+        "y" => FovAxis::Y,
+        "diagonal" => FovAxis::Diagonal,
+        "smaller" => FovAxis::Smaller,
+        "larger" => FovAxis::Larger,
+        other => return Err((sensor.line, format!("unknown fov_axis \"{other}\""))),
+    };
+    Ok((fov, fov_axis))
+}
+
+/// The camera of a `perspective`, `thinlens` or `orthographic` sensor.
 fn read_camera(
     path: &Path,
     sensor: &Plugin,
@@ -302,21 +322,7 @@ fn read_camera(
     let lens = (sensor.kind == "thinlens")
         .then(|| read_lens(sensor))
         .transpose()?;
-    let fov = sensor.float("fov", 39.3077)?;
-    if !(fov > 0.0 && fov < 180.0) {
-        return Err((
-            sensor.line,
-            format!("fov must be in (0, 180) degrees, got {fov}"),
-        ));
-    }
-    let fov_axis = match sensor.string("fov_axis")?.unwrap_or("x") {
-        "x" => FovAxis::X,
-        "y" => FovAxis::Y,
-        "diagonal" => FovAxis::Diagonal,
-        "smaller" => FovAxis::Smaller,
-        "larger" => FovAxis::Larger,
-        other => return Err((sensor.line, format!("unknown fov_axis \"{other}\""))),
-    };
+    let (fov, fov_axis) = read_fov(sensor)?;
     let camera = CameraDescription {
         to_world: sensor.transform("to_world")?,
         projection: Projection::Perspective,
