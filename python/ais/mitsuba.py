@@ -11,8 +11,8 @@ the same expectation as Mitsuba's ``direct`` integrator, so the two agree within
 
 Needs ``pip install mitsuba``. The default variant ``llvm_ad_rgb`` needs the LLVM library
 (Debian: ``apt install libllvm19``); it is found in the usual places, or set
-``DRJIT_LIBLLVM_PATH``. ``--variant scalar_rgb`` needs nothing but runs one ray per
-Python-visible lane and is very slow.
+``DRJIT_LIBLLVM_PATH``. Every round is vectorised over all pixels, so the variant must
+be a vectorised one (``llvm_ad_rgb``, ``llvm_rgb``); scalar variants are refused.
 """
 
 from __future__ import annotations
@@ -51,6 +51,10 @@ def find_llvm() -> Optional[str]:
 
 def import_mitsuba(variant: str):
     """Mitsuba with ``variant`` set; for llvm variants, the LLVM library found first."""
+    if variant.startswith("scalar"):
+        raise RuntimeError(
+            f"ais.mitsuba vectorises every round over all pixels: use an llvm variant, not {variant}"
+        )
     if variant.startswith("llvm"):
         llvm = find_llvm()
         if llvm is None:

@@ -123,3 +123,10 @@ def test_ais_inside_mitsuba_is_unbiased(scenes_with_assets, tmp_path):
     whole = (a.mean(axis=1), b.mean(axis=1))
     whole_error = np.sqrt(sum(w.var(ddof=1) / len(w) for w in whole))
     assert abs(whole[0].mean() - whole[1].mean()) < 4 * whole_error
+
+
+def test_scalar_variants_are_refused():
+    from ais.mitsuba import import_mitsuba
+
+    with pytest.raises(RuntimeError, match="use an llvm variant"):
+        import_mitsuba("scalar_rgb")

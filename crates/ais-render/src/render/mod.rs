@@ -5,8 +5,10 @@
 //! fresh state from the integrator ([`SampleIntegrator::begin_tile`]), asks it for the
 //! value of each camera ray, and merges the tiles' statistics. An integrator that learns
 //! renders in passes ([`SampleIntegrator::passes`]): after each pass the loop merges what
-//! the tiles observed into its [`Learning`], which the next pass reads. Pass 0 seeds each
-//! pixel's generator as a one-pass render does; later passes mix their index into the seed.
+//! the tiles observed into its [`Learning`], which the next pass reads; once the learning
+//! says more passes cannot pay ([`Learning::keeps_learning`]), the remaining samples run as
+//! one pass. Pass 0 seeds each pixel's generator as a one-pass render does; later passes mix
+//! their index into the seed.
 
 mod counts;
 mod integrator;
