@@ -12,8 +12,8 @@ script prints per configuration the mean relMSE against the reference (relMSE = 
 / (r² + 0.01))) with its standard error over seeds, the mean render time, and the
 efficiency ratio against the first configuration: (relMSE · time) of the first over that of
 the row, with its noise from the two relMSE standard errors. Configurations whose learning
-happens between passes (auto) render their spp in passes, so one render is the right unit
-here; `ais compare` renders 1 spp per pass and cannot show them.
+happens between passes (auto) render their spp in passes within one render here; `ais
+compare` keeps one field across its 1-spp passes instead.
 """
 import os
 import re
