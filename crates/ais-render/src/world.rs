@@ -279,10 +279,6 @@ fn environment(
     match plugin.kind.as_str() {
         "constant" => {
             scene::warn_unknown(file, plugin, &["radiance"], warnings);
-            // Mitsuba's default radiance is 1.
-            if !plugin.properties.contains_key("radiance") {
-                return Ok(Environment::Constant(Vec3::ONE));
-            }
             Ok(Environment::Constant(radiance_property(
                 file, plugin, "radiance",
             )?))
