@@ -12,7 +12,7 @@ use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
 use ais_render::integrators::gather::{GatherPoint, Strategy};
 use ais_render::lights::{
-    AreaLight, AreaShape, Environment, EnvironmentGuide, EnvironmentMap, Lights, Rectangle,
+    AreaLight, AreaShape, Environment, EnvironmentGuide, EnvironmentMap, Lights, Rectangle, Toward,
 };
 use base64::Engine;
 use glam::{DMat3, Vec3};
@@ -147,10 +147,10 @@ fn environment_guided_by_an_affinity_map_fits() {
             200_000,
             seed,
             |u| {
-                let d = guide.sample(&map, u);
-                Some((d, guide.pdf(&map, d)))
+                let mut toward = guide.sample(&map, u);
+                Some((toward.direction, guide.pdf(&map, &mut toward)))
             },
-            |d| guide.pdf(&map, d),
+            |d| guide.pdf(&map, &mut Toward::new(d)),
         );
         assert!(p > SIGNIFICANCE, "fraction {fraction}: p = {p}");
     }
@@ -171,7 +171,7 @@ fn environment_guided_by_an_affinity_map_fits() {
             200_000,
             seed,
             |u| strategy.sample(&at, u),
-            |d| strategy.pdf(&at, d),
+            |d| strategy.pdf(&at, &mut Toward::new(d)),
         );
         assert!(p > SIGNIFICANCE, "guided {strategy:?}: p = {p}");
     }
@@ -352,7 +352,7 @@ fn every_gather_proposal_fits() {
             200_000,
             10 + seed as u64,
             |u| strategy.sample(&at, u),
-            |d| strategy.pdf(&at, d),
+            |d| strategy.pdf(&at, &mut Toward::new(d)),
         );
         assert!(p > SIGNIFICANCE, "{strategy:?}: p = {p}");
     }

@@ -10,14 +10,17 @@
 //! Sampling is piecewise constant in solid angle over the cells between four neighbouring
 //! texel centres, each weighted by the mean luminance of its corners times its solid angle,
 //! so the density is positive wherever the interpolated radiance is. Both the row and the
-//! cell within it are drawn by alias tables, and each cell's density is stored, so that a
-//! sample, a density and a radiance lookup each cost O(1) whatever the image size. Like
-//! Mitsuba's RGB variants, all of it is f32; directions are located with [`fast_trig`],
-//! within 4e-7 rad of libm.
+//! cell within it are drawn by alias tables ([`AliasGrid`]), and each cell's density is
+//! stored, so that a sample, a density and a radiance lookup each cost O(1) whatever the
+//! image size. A sample knows its cell and its (u, v), and a [`Toward`] carries them to the
+//! density and radiance lookups; a direction from elsewhere (BSDF sampling) is located on the
+//! map once. Like Mitsuba's RGB variants, all of it is f32; directions are located with
+//! [`fast_trig`], within 4e-7 rad of libm.
 
+use super::Toward;
 use crate::image_io::RgbImage;
 use ais::fast_trig;
-use ais::sampling::{uniform_sphere, AliasTable};
+use ais::sampling::{uniform_sphere, AliasGrid};
 use glam::{DMat3, Mat3, Vec3};
 use std::f32::consts::PI as PI32;
 use std::f64::consts::PI;
@@ -42,11 +45,9 @@ pub struct EnvironmentMap {
     image: RgbImage,
     to_world: Mat3,
     to_local: Mat3,
-    /// The `height − 1` rows of cells by probability. Cell (c, r) has texel centres (c, r)
-    /// and (c + 1, r + 1) at its corners.
-    rows: AliasTable,
-    /// For each row, its `width` cells by probability within the row.
-    columns: Vec<AliasTable>,
+    /// The `width × (height − 1)` cells by probability (row-major). Cell (c, r) has texel
+    /// centres (c, r) and (c + 1, r + 1) at its corners.
+    cells: AliasGrid,
     /// The sampling density of each cell in solid angle (row-major, `width × (height − 1)`).
     cell_density: Vec<f32>,
     /// cos θ of each texel row.
@@ -54,14 +55,11 @@ pub struct EnvironmentMap {
     mean_luminance: f64,
     /// Its cells grouped by map texels, for guided light sampling.
     partitions: super::environment_guide::PartitionCache,
-    /// Unique among the maps of a process (clones share it, and their contents), to key
-    /// the last lookup of each thread.
-    id: u64,
 }
 
 /// Where a direction falls on an environment map: Mitsuba's (u, v) and the sampling cell.
 #[derive(Clone, Copy, Debug)]
-struct MapLocation {
+pub struct MapLocation {
     u: f32,
     v: f32,
     cell: usize,
@@ -83,8 +81,6 @@ impl EnvironmentMap {
             |row: usize| 2.0 * PI / width as f64 * (row_cosines[row] - row_cosines[row + 1]);
         let weights = cell_weights(&image, &row_cosines);
         let total: f64 = weights.iter().sum();
-        let columns: Vec<AliasTable> = weights.chunks_exact(width).map(AliasTable::new).collect();
-        let rows = AliasTable::new(&columns.iter().map(AliasTable::total).collect::<Vec<_>>());
         let cell_density = weights
             .iter()
             .enumerate()
@@ -98,8 +94,7 @@ impl EnvironmentMap {
             })
             .collect();
         EnvironmentMap {
-            rows,
-            columns,
+            cells: AliasGrid::new(&weights, width),
             cell_density,
             to_local: to_world.inverse().as_mat3(),
             to_world: to_world.as_mat3(),
@@ -107,33 +102,13 @@ impl EnvironmentMap {
             row_cosines: row_cosines.iter().map(|&c| c as f32).collect(),
             mean_luminance: total / (4.0 * PI),
             partitions: Default::default(),
-            id: NEXT_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
         }
-    }
-
-    /// [`EnvironmentMap::locate`], remembering the last direction of this thread: a traced
-    /// candidate asks for its density and then its radiance, so the second lookup is free.
-    #[inline]
-    fn locate(&self, direction: Vec3) -> MapLocation {
-        thread_local! {
-            static LAST: std::cell::Cell<Option<(u64, [u32; 3], MapLocation)>> =
-                const { std::cell::Cell::new(None) };
-        }
-        let key = (self.id, direction.to_array().map(f32::to_bits));
-        LAST.with(|last| match last.get() {
-            Some((map, bits, location)) if (map, bits) == key => location,
-            _ => {
-                let location = self.locate_anew(direction);
-                last.set(Some((key.0, key.1, location)));
-                location
-            }
-        })
     }
 
     /// Where `direction` (unit, world space) falls: Mitsuba's u = atan2(x, −z) / 2π ∈ [0, 1)
     /// and v = acos(y) / π ∈ [0, 1] in the emitter's frame, and the sampling cell there.
     #[inline]
-    fn locate_anew(&self, direction: Vec3) -> MapLocation {
+    pub(super) fn locate(&self, direction: Vec3) -> MapLocation {
         let d = self.to_local * direction;
         let mut u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI32);
         if u < 0.0 {
@@ -163,7 +138,12 @@ impl EnvironmentMap {
         let x = location.u * width as f32 - 0.5;
         let x0 = x.floor();
         let fx = x - x0;
-        let c0 = (x0 as i64).rem_euclid(width as i64) as usize;
+        // x ≥ −½: only the first half texel wraps around to the last column.
+        let c0 = if x0 < 0.0 {
+            width - 1
+        } else {
+            (x0 as usize).min(width - 1)
+        };
         let c1 = if c0 + 1 == width { 0 } else { c0 + 1 };
         let y = location.v.clamp(0.0, 1.0) * (height - 1) as f32;
         let r0 = (y as usize).min(height - 2);
@@ -174,23 +154,25 @@ impl EnvironmentMap {
         top.lerp(bottom, fy)
     }
 
-    /// A direction drawn from `u` and its density in solid angle: a row of cells, a cell in
-    /// it, then a point uniform in φ and cos θ within the cell, so the density is the cell's.
+    /// A direction drawn from `u`, located: a row of cells, a cell in it, then a point
+    /// uniform in φ and cos θ within the cell, so the density is the cell's
+    /// ([`EnvironmentMap::density_at`]).
     #[inline]
-    pub(crate) fn sample(&self, u: [f32; 2]) -> (Vec3, f32) {
-        let (row, fy) = self.rows.sample(u[1]);
-        let (column, fx) = self.columns[row].sample(u[0]);
-        let cell = row * self.image.width + column;
-        (
-            self.direction_in_cell(cell, [fx, fy]),
-            self.cell_density[cell],
-        )
+    pub(crate) fn sample(&self, u: [f32; 2]) -> Toward {
+        let (cell, within) = self.cells.sample(u);
+        self.toward_in_cell(cell, within)
     }
 
-    /// The sampling density at `direction`, in solid angle.
+    /// The sampling density at a located direction, in solid angle.
     #[inline]
-    fn pdf(&self, direction: Vec3) -> f32 {
-        self.cell_density[self.locate(direction).cell]
+    pub(crate) fn density_at(&self, location: MapLocation) -> f32 {
+        self.cell_density[location.cell]
+    }
+
+    /// The radiance at a located direction.
+    #[inline]
+    pub(crate) fn radiance_at(&self, location: MapLocation) -> Vec3 {
+        self.interpolate(location)
     }
 
     /// Its cells grouped by the texels of `layout` (built once, then shared).
@@ -219,8 +201,7 @@ impl EnvironmentMap {
 
     /// Probability that sampling picks `cell`.
     pub(crate) fn cell_probability(&self, cell: usize) -> f64 {
-        let (column, row) = (cell % self.image.width, cell / self.image.width);
-        self.rows.probability(row) as f64 * self.columns[row].probability(column) as f64
+        self.cells.probability(cell) as f64
     }
 
     /// The world direction through the centre of `cell`.
@@ -231,22 +212,38 @@ impl EnvironmentMap {
     /// The direction at fractions (`fx`, `fy`) ∈ [0, 1)² of `cell`'s azimuth and cos θ range:
     /// with uniform fractions, uniform in solid angle over the cell, as sampling draws.
     #[inline]
-    pub(crate) fn direction_in_cell(&self, cell: usize, [fx, fy]: [f32; 2]) -> Vec3 {
+    pub(crate) fn direction_in_cell(&self, cell: usize, within: [f32; 2]) -> Vec3 {
+        self.toward_in_cell(cell, within).direction
+    }
+
+    /// [`EnvironmentMap::direction_in_cell`], located: its (u, v) follow from the cell and
+    /// the fractions without a second trip through atan2.
+    #[inline]
+    pub(crate) fn toward_in_cell(&self, cell: usize, [fx, fy]: [f32; 2]) -> Toward {
         let width = self.image.width;
         let (column, row) = (cell % width, cell / width);
         let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
         let cos_theta = (top + fy * (bottom - top)).clamp(-1.0, 1.0);
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-        let phi = 2.0 * PI32 * (column as f32 + 0.5 + fx) / width as f32;
-        let (sin_phi, cos_phi) = phi.sin_cos();
+        let mut u = (column as f32 + 0.5 + fx) / width as f32;
+        if u >= 1.0 {
+            u -= 1.0;
+        }
+        let u = u.min(ONE_BELOW);
+        let (sin_phi, cos_phi) = (2.0 * PI32 * u).sin_cos();
         let local = Vec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
-        (self.to_world * local).normalize()
+        let location = MapLocation {
+            u,
+            v: fast_trig::acos(cos_theta) * (1.0 / PI32),
+            cell,
+        };
+        Toward::located((self.to_world * local).normalize(), location)
     }
 
     /// The sampling density at `direction` (solid angle) and the cell it falls in.
     #[inline]
-    pub(crate) fn pdf_and_cell(&self, direction: Vec3) -> (f32, usize) {
-        let cell = self.locate(direction).cell;
+    pub(crate) fn pdf_and_cell(&self, toward: &mut Toward) -> (f32, usize) {
+        let cell = toward.location(self).cell;
         (self.cell_density[cell], cell)
     }
 }
@@ -275,34 +272,48 @@ fn cell_weights(image: &RgbImage, row_cosines: &[f64]) -> Vec<f64> {
 /// The largest f32 below 1.
 const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
-/// The next [`EnvironmentMap`]'s id.
-static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
-
 impl Environment {
     /// Radiance arriving from `direction` (unit, world space).
     pub fn radiance(&self, direction: Vec3) -> Vec3 {
+        self.radiance_toward(&mut Toward::new(direction))
+    }
+
+    /// [`Environment::radiance`] at a direction that may already be located on the map.
+    #[inline]
+    pub fn radiance_toward(&self, toward: &mut Toward) -> Vec3 {
         match self {
             Environment::Constant(radiance) => *radiance,
-            Environment::Map(map) => map.interpolate(map.locate(direction)),
+            Environment::Map(map) => map.radiance_at(toward.location(map)),
         }
     }
 
     /// A direction drawn from `u` and its density in solid angle.
     pub fn sample(&self, u: [f32; 2]) -> (Vec3, f64) {
+        let mut toward = self.sample_toward(u);
+        let density = self.pdf_toward(&mut toward);
+        (toward.direction, density)
+    }
+
+    /// A direction drawn from `u`, located on the map.
+    #[inline]
+    pub fn sample_toward(&self, u: [f32; 2]) -> Toward {
         match self {
-            Environment::Constant(_) => (uniform_sphere(u), 1.0 / (4.0 * PI)),
-            Environment::Map(map) => {
-                let (direction, density) = map.sample(u);
-                (direction, density as f64)
-            }
+            Environment::Constant(_) => Toward::new(uniform_sphere(u)),
+            Environment::Map(map) => map.sample(u),
         }
     }
 
     /// Density of [`Environment::sample`] at `direction`, in solid angle.
     pub fn pdf(&self, direction: Vec3) -> f64 {
+        self.pdf_toward(&mut Toward::new(direction))
+    }
+
+    /// [`Environment::pdf`] at a direction that may already be located on the map.
+    #[inline]
+    pub fn pdf_toward(&self, toward: &mut Toward) -> f64 {
         match self {
             Environment::Constant(_) => 1.0 / (4.0 * PI),
-            Environment::Map(map) => map.pdf(direction) as f64,
+            Environment::Map(map) => map.density_at(toward.location(map)) as f64,
         }
     }
 

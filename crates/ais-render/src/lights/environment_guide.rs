@@ -11,9 +11,8 @@
 //! the price of two short inversions and no rejected candidate. Inversion all the way down
 //! keeps stratified `u` stratified.
 
-use super::EnvironmentMap;
+use super::{EnvironmentMap, Toward};
 use ais::mapping::{LatLong, Texel};
-use glam::Vec3;
 use std::sync::{Arc, Mutex};
 
 /// The environment's cells grouped by the texels of one map layout: built once per
@@ -192,13 +191,13 @@ impl EnvironmentGuide {
         self.fraction = fraction.clamp(0.0, 1.0);
     }
 
-    /// A direction from the mixture for `u` ∈ [0, 1)².
-    pub fn sample(&self, environment: &EnvironmentMap, u: [f32; 2]) -> Vec3 {
+    /// A direction from the mixture for `u` ∈ [0, 1)², located on the map.
+    pub fn sample(&self, environment: &EnvironmentMap, u: [f32; 2]) -> Toward {
         let beta = self.fraction;
         let u0 = u[0] as f64;
         if u0 >= beta {
             let rescaled = ((u0 - beta) / (1.0 - beta)).clamp(0.0, 1.0 - 1e-7);
-            return environment.sample([rescaled as f32, u[1]]).0;
+            return environment.sample([rescaled as f32, u[1]]);
         }
         let u0 = u0 / beta;
         let texels = self.affinity.len();
@@ -218,12 +217,12 @@ impl EnvironmentGuide {
         let below = if i == 0 { 0.0 } else { within[i - 1] };
         let fx = ((v - below) / (within[i] - below)).clamp(0.0, 1.0 - 1e-7) as f32;
         let cell = partition.cells[range.start + i] as usize;
-        environment.direction_in_cell(cell, [fx, u[1].min(1.0 - 1e-7)])
+        environment.toward_in_cell(cell, [fx, u[1].min(1.0 - 1e-7)])
     }
 
-    /// The mixture's density at `direction` (solid angle).
-    pub fn pdf(&self, environment: &EnvironmentMap, direction: Vec3) -> f64 {
-        let (density, cell) = environment.pdf_and_cell(direction);
+    /// The mixture's density at a direction (solid angle).
+    pub fn pdf(&self, environment: &EnvironmentMap, toward: &mut Toward) -> f64 {
+        let (density, cell) = environment.pdf_and_cell(toward);
         let product =
             self.affinity[self.partition.cell_texel[cell] as usize] as f64 / self.normaliser;
         density as f64 * ((1.0 - self.fraction) + self.fraction * product)

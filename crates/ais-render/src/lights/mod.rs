@@ -6,12 +6,14 @@ mod environment;
 mod environment_guide;
 mod mesh_emitter;
 mod spherical_rectangle;
+mod toward;
 
 pub use area::{AreaLight, AreaSample, AreaShape};
 pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
 pub use mesh_emitter::MeshEmitter;
 pub use spherical_rectangle::Rectangle;
+pub use toward::Toward;
 
 use crate::geometry::Ray;
 use ais::sampling::AliasTable;
@@ -73,25 +75,28 @@ impl Lights {
     /// power, then a direction toward it. Its density is [`Lights::pdf`] (all lights that
     /// could have produced it), which callers evaluate once.
     pub fn sample_direction(&self, point: Vec3, u: [f32; 2]) -> Option<Vec3> {
-        self.sample_direction_guided(point, u, None)
+        Some(self.sample_toward(point, u, None)?.direction)
     }
 
-    /// [`Lights::sample_direction`] with the environment map sampled by `guide` (its product
-    /// with an affinity map) when given; the density is then [`Lights::pdf_guided`].
-    pub fn sample_direction_guided(
+    /// [`Lights::sample_direction`], located on the environment map when drawn from it, with
+    /// the environment map sampled by `guide` (its product with an affinity map) when given;
+    /// the density is then [`Lights::pdf_toward`] with the same guide.
+    #[inline]
+    pub fn sample_toward(
         &self,
         point: Vec3,
         u: [f32; 2],
         guide: Option<&EnvironmentGuide>,
-    ) -> Option<Vec3> {
+    ) -> Option<Toward> {
         let choice = self.choice.as_ref()?;
         let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
-            return Some(self.area[index].sample(point, [u0, u[1]])?.direction);
+            let sample = self.area[index].sample(point, [u0, u[1]])?;
+            return Some(Toward::new(sample.direction));
         }
         match (self.environment.as_ref()?, guide) {
             (Environment::Map(map), Some(guide)) => Some(guide.sample(map, [u0, u[1]])),
-            (environment, _) => Some(environment.sample([u0, u[1]]).0),
+            (environment, _) => Some(environment.sample_toward([u0, u[1]])),
         }
     }
 
@@ -104,27 +109,28 @@ impl Lights {
 
     /// Density of light sampling at `direction` from `point`, in solid angle.
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
-        self.pdf_guided(point, direction, None)
+        self.pdf_toward(point, &mut Toward::new(direction), None)
     }
 
-    /// Density of [`Lights::sample_direction_guided`] with the same `guide`.
-    pub fn pdf_guided(
+    /// Density of [`Lights::sample_toward`] with the same `guide`.
+    #[inline]
+    pub fn pdf_toward(
         &self,
         point: Vec3,
-        direction: Vec3,
+        toward: &mut Toward,
         guide: Option<&EnvironmentGuide>,
     ) -> f64 {
         let mut pdf = 0.0;
         for (index, light) in self.area.iter().enumerate() {
             let p = self.choice_probability(index);
             if p > 0.0 {
-                pdf += p * light.pdf(point, direction);
+                pdf += p * light.pdf(point, toward.direction);
             }
         }
         if let Some(environment) = &self.environment {
             let density = match (environment, guide) {
-                (Environment::Map(map), Some(guide)) => guide.pdf(map, direction),
-                (environment, _) => environment.pdf(direction),
+                (Environment::Map(map), Some(guide)) => guide.pdf(map, toward),
+                (environment, _) => environment.pdf_toward(toward),
             };
             pdf += self.choice_probability(self.area.len()) * density;
         }
@@ -133,8 +139,10 @@ impl Lights {
 
     /// Radiance arriving along the ray from the first emitter, ignoring every occluder that
     /// is not an emitter, and the distance to that emitter (infinite for the environment):
-    /// what the ray would bring if nothing blocked it, and how far it must be free.
-    pub fn unoccluded(&self, ray: &Ray) -> (Vec3, f32) {
+    /// what the ray would bring if nothing blocked it, and how far it must be free. `toward`
+    /// is the ray's direction, perhaps already located on the environment map.
+    #[inline]
+    pub fn unoccluded(&self, ray: &Ray, toward: &mut Toward) -> (Vec3, f32) {
         let nearest = self
             .area
             .iter()
@@ -142,7 +150,13 @@ impl Lights {
             .min_by(|a, b| a.0.total_cmp(&b.0));
         match nearest {
             Some((t, normal, light)) => (light.emitted(normal, ray.direction), t),
-            None => (self.background(ray.direction), f32::INFINITY),
+            None => {
+                let background = self
+                    .environment
+                    .as_ref()
+                    .map_or(Vec3::ZERO, |e| e.radiance_toward(toward));
+                (background, f32::INFINITY)
+            }
         }
     }
 

@@ -10,7 +10,7 @@
 
 /// One bin of an alias table.
 #[derive(Clone, Copy, Debug)]
-struct AliasBin {
+pub(crate) struct AliasBin {
     /// The bin keeps itself when the fraction is below this.
     threshold: f32,
     /// The bin given otherwise.
@@ -66,22 +66,29 @@ impl AliasTable {
     /// independent of the bin when `u` is uniform. It carries about 24 − log2(len) bits.
     #[inline]
     pub fn sample(&self, u: f32) -> (usize, f32) {
-        let n = self.bins.len();
-        let scaled = u.clamp(0.0, 1.0) * n as f32;
-        let i = (scaled as usize).min(n - 1);
-        let fraction = (scaled - i as f32).clamp(0.0, 1.0);
-        let bin = self.bins[i];
-        if fraction < bin.threshold {
-            (i, (fraction / bin.threshold).min(ONE_BELOW))
+        draw(&self.bins, u)
+    }
+}
+
+/// The bin of `bins` (a table built by [`build_bins`]) drawn from `u`, and what is left of
+/// `u`: [`AliasTable::sample`].
+#[inline]
+pub(crate) fn draw(bins: &[AliasBin], u: f32) -> (usize, f32) {
+    let n = bins.len();
+    let scaled = u.clamp(0.0, 1.0) * n as f32;
+    let i = (scaled as usize).min(n - 1);
+    let fraction = (scaled - i as f32).clamp(0.0, 1.0);
+    let bin = bins[i];
+    if fraction < bin.threshold {
+        (i, (fraction / bin.threshold).min(ONE_BELOW))
+    } else {
+        let rest = 1.0 - bin.threshold;
+        let left = if rest > 0.0 {
+            (fraction - bin.threshold) / rest
         } else {
-            let rest = 1.0 - bin.threshold;
-            let left = if rest > 0.0 {
-                (fraction - bin.threshold) / rest
-            } else {
-                0.0
-            };
-            (bin.alias as usize, left.clamp(0.0, ONE_BELOW))
-        }
+            0.0
+        };
+        (bin.alias as usize, left.clamp(0.0, ONE_BELOW))
     }
 }
 
@@ -90,7 +97,7 @@ const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Vose's construction: bins scaled to mean 1, each under-full bin topped up by an
 /// over-full one.
-fn build_bins(weights: &[f64], sum: f64) -> Vec<AliasBin> {
+pub(crate) fn build_bins(weights: &[f64], sum: f64) -> Vec<AliasBin> {
     let n = weights.len();
     let mut scaled: Vec<f64> = weights.iter().map(|&w| w * n as f64 / sum).collect();
     let mut bins: Vec<AliasBin> = (0..n)

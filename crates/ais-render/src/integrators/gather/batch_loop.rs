@@ -6,7 +6,7 @@ use super::guiding::CandidateSampler;
 use super::light::Leaving;
 use super::settings::{GatherSettings, MapUse};
 use super::strategy::GatherPoint;
-use crate::lights::luminance;
+use crate::lights::{luminance, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
@@ -92,17 +92,18 @@ pub fn run_batch<P: BatchProbe>(
     batch.begin(run.settings.rays, run.seed, run.start);
     let mut values = RunningMean::default();
     while let Some(candidate) = batch.next_candidate() {
-        let Some(direction) = run.sampler.sample_direction(at, candidate.u) else {
+        let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
             probe.decided(at.frame.normal, false);
             batch.decide(at.frame.normal, false);
             continue;
         };
+        let direction = toward.direction;
         let in_support = at.material.in_support(&at.frame, at.wo, direction);
         probe.decided(direction, in_support);
-        let (decision, known) = decide(run, batch, &mut values, direction, in_support);
+        let (decision, known) = decide(run, batch, &mut values, &mut toward, in_support);
         if let Decision::Trace { .. } = decision {
             let started = run.clock.map(|_| Instant::now());
-            let (value, rating) = trace(run, direction, known, counts);
+            let (value, rating) = trace(run, toward, known, counts);
             if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), rating.free()) {
                 recorder.record(direction.into(), free);
             }
@@ -133,10 +134,11 @@ fn decide(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
     values: &mut RunningMean,
-    direction: Vec3,
+    toward: &mut Toward,
     in_support: bool,
 ) -> (Decision, Option<Known>) {
     let acceptance = run.settings.acceptance;
+    let direction = toward.direction;
     if let Some(field) = &run.field {
         // Visibility alone: computing each candidate's value before deciding (to always
         // trace the bright ones) cost more time than it saved, measured on the rooms.
@@ -146,7 +148,7 @@ fn decide(
         return (decision, None);
     }
     if acceptance.needs_value() && in_support {
-        let (value, known) = unoccluded_value(run, direction);
+        let (value, known) = unoccluded_value(run, toward);
         let mean = values.mean_then_add(value);
         let decision = batch.decide_with(direction, in_support, |affinity| {
             acceptance.probability(affinity, value, mean)
@@ -166,12 +168,12 @@ fn decide(
 
 /// The candidate's unoccluded value (luminance of f·L/p with nothing in the way), and what
 /// tracing it will need.
-fn unoccluded_value(run: &BatchRun, direction: Vec3) -> (f32, Known) {
+fn unoccluded_value(run: &BatchRun, toward: &mut Toward) -> (f32, Known) {
     let at = run.at;
-    let density = run.sampler.pdf(at, direction);
-    let leaving = Leaving::new(run.world, at, direction);
+    let density = run.sampler.pdf(at, toward);
+    let leaving = Leaving::new(run.world, at, toward);
     let value = if density > 0.0 {
-        luminance(at.material.eval(&at.frame, at.wo, direction) * leaving.unoccluded)
+        luminance(at.material.eval(&at.frame, at.wo, toward.direction) * leaving.unoccluded)
             / density as f32
     } else {
         0.0
@@ -197,17 +199,18 @@ impl Seen {
 /// Traces an accepted candidate: its contribution f·L/p and what it saw.
 fn trace(
     run: &BatchRun,
-    direction: Vec3,
+    mut toward: Toward,
     known: Option<Known>,
     counts: &mut RayCounts,
 ) -> (Vec3, Seen) {
     let at = run.at;
+    let direction = toward.direction;
     let Known {
         density: pdf,
         leaving,
     } = known.unwrap_or_else(|| Known {
-        density: run.sampler.pdf(at, direction),
-        leaving: Leaving::new(run.world, at, direction),
+        density: run.sampler.pdf(at, &mut toward),
+        leaving: Leaving::new(run.world, at, &mut toward),
     });
     // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 {

@@ -17,10 +17,9 @@
 //! unbiased whatever the map says, and a wrong map costs at most `1 / (1 − α)` in variance.
 
 use super::strategy::{GatherPoint, Strategy};
-use crate::lights::{Environment, EnvironmentGuide};
+use crate::lights::{Environment, EnvironmentGuide, Toward};
 use ais::mapping::LatLong;
 use ais::{AffinityMap, TexelDistribution};
-use glam::Vec3;
 
 /// The default share α of the guide in the mixture `q = (1 − α) p + α g`.
 pub const GUIDE_FRACTION: f32 = 0.5;
@@ -59,27 +58,29 @@ impl<'a> CandidateSampler<'a> {
     }
 
     /// A candidate direction from `u` ∈ [0, 1)² (`None`: the strategy gave none).
-    pub fn sample_direction(&self, at: &GatherPoint, u: [f32; 2]) -> Option<Vec3> {
+    #[inline]
+    pub fn sample_direction(&self, at: &GatherPoint, u: [f32; 2]) -> Option<Toward> {
         let Some(guide) = self.guide else {
             return self.strategy.sample_direction(at, u);
         };
         let alpha = self.fraction;
         if u[0] < alpha {
-            Some(guide.sample([u[0] / alpha, u[1]]))
+            Some(Toward::new(guide.sample([u[0] / alpha, u[1]])))
         } else {
             let rescaled = ((u[0] - alpha) / (1.0 - alpha)).min(1.0 - 1e-7);
             self.strategy.sample_direction(at, [rescaled, u[1]])
         }
     }
 
-    /// The proposal's density at `direction`, in solid angle.
-    pub fn pdf(&self, at: &GatherPoint, direction: Vec3) -> f64 {
-        let p = self.strategy.pdf(at, direction);
+    /// The proposal's density at a direction, in solid angle.
+    #[inline]
+    pub fn pdf(&self, at: &GatherPoint, toward: &mut Toward) -> f64 {
+        let p = self.strategy.pdf(at, toward);
         match self.guide {
             None => p,
             Some(guide) => {
                 let alpha = self.fraction as f64;
-                (1.0 - alpha) * p + alpha * guide.pdf(direction) as f64
+                (1.0 - alpha) * p + alpha * guide.pdf(toward.direction) as f64
             }
         }
     }
@@ -164,7 +165,7 @@ impl Guide {
             if !at.material.in_support(&at.frame, at.wo, centre) {
                 return 0.0;
             }
-            let density = strategy.pdf(at, centre) as f32;
+            let density = strategy.pdf(at, &mut Toward::new(centre)) as f32;
             map.texel_affinity(0, texel) * density * layout.texel_solid_angle(texel.row)
         });
         if built {

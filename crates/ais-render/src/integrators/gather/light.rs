@@ -3,6 +3,7 @@
 
 use super::strategy::GatherPoint;
 use crate::geometry::{spawn_ray, Ray};
+use crate::lights::Toward;
 use crate::render::RayCounts;
 use crate::world::World;
 use glam::Vec3;
@@ -19,10 +20,11 @@ pub(crate) struct Leaving {
 }
 
 impl Leaving {
-    /// The ray leaving `at` toward `direction`.
-    pub fn new(world: &World, at: &GatherPoint, direction: Vec3) -> Self {
-        let ray = spawn_ray(at.point, at.frame.geometric, direction);
-        let (unoccluded, distance) = world.lights.unoccluded(&ray);
+    /// The ray leaving `at` toward a direction.
+    #[inline]
+    pub fn new(world: &World, at: &GatherPoint, toward: &mut Toward) -> Self {
+        let ray = spawn_ray(at.point, at.frame.geometric, toward.direction);
+        let (unoccluded, distance) = world.lights.unoccluded(&ray, toward);
         Leaving {
             ray,
             unoccluded,
@@ -56,5 +58,5 @@ pub fn arriving_light(
     direction: Vec3,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    Leaving::new(world, at, direction).trace(world, counts)
+    Leaving::new(world, at, &mut Toward::new(direction)).trace(world, counts)
 }

@@ -3,7 +3,7 @@
 
 use crate::bsdf::{Material, ShadingFrame};
 use crate::geometry::Hit;
-use crate::lights::{EnvironmentGuide, Lights};
+use crate::lights::{EnvironmentGuide, Lights, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
@@ -94,38 +94,34 @@ impl Strategy {
         match self.effective(at) {
             Strategy::Uniform => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
             Strategy::Bsdf => Some(at.material.sample(&at.frame, at.wo, u)),
-            Strategy::Light => {
-                let direction = self.sample_direction(at, u)?;
-                let pdf = self.pdf(at, direction);
-                (pdf > 0.0).then_some((direction, pdf))
-            }
-            Strategy::Mis => {
-                let direction = self.sample_direction(at, u)?;
-                let pdf = self.pdf(at, direction);
-                (pdf > 0.0).then_some((direction, pdf))
+            Strategy::Light | Strategy::Mis => {
+                let mut toward = self.sample_direction(at, u)?;
+                let pdf = self.pdf(at, &mut toward);
+                (pdf > 0.0).then_some((toward.direction, pdf))
             }
         }
     }
 
     /// The direction of [`Strategy::sample`] without its density, which costs more than the
     /// direction for light sampling and MIS: a gather that may skip the candidate asks for
-    /// the density only when it traces it.
-    pub fn sample_direction(self, at: &GatherPoint, u: [f32; 2]) -> Option<Vec3> {
+    /// the density only when it traces it. A direction drawn from the environment map
+    /// carries its place there, for the density and the radiance.
+    #[inline]
+    pub fn sample_direction(self, at: &GatherPoint, u: [f32; 2]) -> Option<Toward> {
         match self.effective(at) {
-            Strategy::Uniform => Some(uniform_sphere(u)),
+            Strategy::Uniform => Some(Toward::new(uniform_sphere(u))),
             Strategy::Bsdf => {
                 let (direction, pdf) = at.material.sample(&at.frame, at.wo, u);
-                (pdf > 0.0).then_some(direction)
+                (pdf > 0.0).then_some(Toward::new(direction))
             }
-            Strategy::Light => at
-                .lights
-                .sample_direction_guided(at.point, u, at.environment_guide),
+            Strategy::Light => at.lights.sample_toward(at.point, u, at.environment_guide),
             Strategy::Mis => {
                 let w = MIS_BSDF_WEIGHT as f32;
                 if u[0] < w {
-                    Some(at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]).0)
+                    let (direction, _) = at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]);
+                    Some(Toward::new(direction))
                 } else {
-                    at.lights.sample_direction_guided(
+                    at.lights.sample_toward(
                         at.point,
                         [((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]],
                         at.environment_guide,
@@ -135,19 +131,18 @@ impl Strategy {
         }
     }
 
-    /// The strategy's density at `direction`.
-    pub fn pdf(self, at: &GatherPoint, direction: Vec3) -> f64 {
+    /// The strategy's density at a direction.
+    #[inline]
+    pub fn pdf(self, at: &GatherPoint, toward: &mut Toward) -> f64 {
+        let light =
+            |toward: &mut Toward| at.lights.pdf_toward(at.point, toward, at.environment_guide);
         match self.effective(at) {
             Strategy::Uniform => 1.0 / (4.0 * PI),
-            Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, direction),
-            Strategy::Light => at
-                .lights
-                .pdf_guided(at.point, direction, at.environment_guide),
+            Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, toward.direction),
+            Strategy::Light => light(toward),
             Strategy::Mis => {
-                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, direction)
-                    + (1.0 - MIS_BSDF_WEIGHT)
-                        * at.lights
-                            .pdf_guided(at.point, direction, at.environment_guide)
+                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, toward.direction)
+                    + (1.0 - MIS_BSDF_WEIGHT) * light(toward)
             }
         }
     }
