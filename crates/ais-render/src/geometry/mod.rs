@@ -6,6 +6,7 @@ mod primitive;
 mod ray;
 
 pub use basis::basis;
+use primitive::Packed;
 pub use primitive::{Primitive, Sphere, Triangle};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
 
@@ -56,15 +57,30 @@ struct MeshShading {
 
 /// The scene's primitives in a CWBVH.
 pub struct Geometry {
-    /// Primitives in BVH order (the BVH's primitive index is the position here).
+    /// Primitives as given, until the BVH is built.
     primitives: Vec<Primitive>,
-    /// The shape of each primitive, in the same order.
-    primitive_shapes: Vec<u32>,
+    /// Primitives in BVH order, packed for intersection (the BVH's primitive index is the
+    /// position here).
+    packed: Vec<Packed>,
+    /// For each packed primitive: its shape, and for a triangle its mesh and index there.
+    sources: Vec<PrimitiveSource>,
     meshes: Vec<MeshShading>,
     shape_flips: Vec<bool>,
     bvh: Option<CwBvh>,
     triangle_count: usize,
+    /// Centre and radius of a sphere around everything.
+    bounds: (Vec3, f32),
     build_time: Duration,
+}
+
+/// Where a primitive came from: what shading a hit on it needs.
+#[derive(Clone, Copy, Debug)]
+struct PrimitiveSource {
+    shape: u32,
+    /// The triangle's mesh (unused for a sphere).
+    mesh: u32,
+    /// The triangle's index in its mesh (unused for a sphere).
+    index: u32,
 }
 
 impl Geometry {
@@ -73,16 +89,19 @@ impl Geometry {
         let started = Instant::now();
         let mut geometry = Geometry {
             primitives: Vec::new(),
-            primitive_shapes: Vec::new(),
+            packed: Vec::new(),
+            sources: Vec::new(),
             meshes: Vec::new(),
             shape_flips: Vec::new(),
             bvh: None,
             triangle_count: 0,
+            bounds: (Vec3::ZERO, 0.0),
             build_time: Duration::ZERO,
         };
         for (shape_index, shape) in shapes.into_iter().enumerate() {
             geometry.add(shape_index as u32, shape);
         }
+        geometry.bounds = bounding_sphere(&geometry.primitives);
         geometry.build_bvh();
         geometry.build_time = started.elapsed();
         geometry
@@ -94,7 +113,11 @@ impl Geometry {
         match shape.geometry {
             ShapeGeometry::Sphere(sphere) => {
                 self.primitives.push(Primitive::Sphere(sphere));
-                self.primitive_shapes.push(shape_index);
+                self.sources.push(PrimitiveSource {
+                    shape: shape_index,
+                    mesh: 0,
+                    index: 0,
+                });
             }
             ShapeGeometry::Mesh(mesh) => {
                 let mesh_index = self.meshes.len() as u32;
@@ -108,7 +131,11 @@ impl Geometry {
                         mesh: mesh_index,
                         index: index as u32,
                     }));
-                    self.primitive_shapes.push(shape_index);
+                    self.sources.push(PrimitiveSource {
+                        shape: shape_index,
+                        mesh: mesh_index,
+                        index: index as u32,
+                    });
                 }
                 self.triangle_count += mesh.triangles.len();
                 self.meshes.push(MeshShading {
@@ -119,23 +146,24 @@ impl Geometry {
         }
     }
 
-    /// Builds the BVH and reorders the primitives into its order, so that traversal needs no
+    /// Builds the BVH and packs the primitives in its order, so that traversal needs no
     /// indirection.
     fn build_bvh(&mut self) {
-        if self.primitives.is_empty() {
+        let primitives = std::mem::take(&mut self.primitives);
+        if primitives.is_empty() {
             return;
         }
         let bvh = obvhs::cwbvh::builder::build_cwbvh(
-            &self.primitives,
+            &primitives,
             obvhs::BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
         let order = &bvh.primitive_indices;
-        self.primitives = order.iter().map(|&i| self.primitives[i as usize]).collect();
-        self.primitive_shapes = order
+        self.packed = order
             .iter()
-            .map(|&i| self.primitive_shapes[i as usize])
+            .map(|&i| Packed::new(&primitives[i as usize]))
             .collect();
+        self.sources = order.iter().map(|&i| self.sources[i as usize]).collect();
         self.bvh = Some(bvh);
     }
 
@@ -146,31 +174,12 @@ impl Geometry {
 
     /// Number of primitives (triangles and spheres).
     pub fn primitive_count(&self) -> usize {
-        self.primitives.len()
+        self.packed.len()
     }
 
     /// Centre and radius of a sphere enclosing every primitive (zero for an empty scene).
     pub fn bounding_sphere(&self) -> (Vec3, f32) {
-        let mut low = Vec3::splat(f32::INFINITY);
-        let mut high = Vec3::splat(f32::NEG_INFINITY);
-        for primitive in &self.primitives {
-            match primitive {
-                Primitive::Triangle(t) => {
-                    for v in t.vertices {
-                        low = low.min(v);
-                        high = high.max(v);
-                    }
-                }
-                Primitive::Sphere(s) => {
-                    low = low.min(s.center - s.radius);
-                    high = high.max(s.center + s.radius);
-                }
-            }
-        }
-        if low.x > high.x {
-            return (Vec3::ZERO, 0.0);
-        }
-        ((low + high) * 0.5, (high - low).length() * 0.5)
+        self.bounds
     }
 
     /// Wall time of [`Geometry::build`].
@@ -180,10 +189,7 @@ impl Geometry {
 
     #[inline]
     fn intersect_primitive(&self, index: usize, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
-        match &self.primitives[index] {
-            Primitive::Triangle(t) => t.intersect(ray, t_max),
-            Primitive::Sphere(s) => s.intersect(ray, t_max).map(|t| (t, Vec2::ZERO)),
-        }
+        self.packed[index].intersect(ray, t_max)
     }
 
     /// The closest hit along the ray, if any.
@@ -206,7 +212,7 @@ impl Geometry {
     /// The closest hit by testing every primitive: the reference the BVH is tested against.
     pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
         let mut best: Option<(usize, f32, Vec2)> = None;
-        for index in 0..self.primitives.len() {
+        for index in 0..self.packed.len() {
             let t_max = best.map_or(ray.t_max, |b| b.1);
             if let Some((t, barycentrics)) = self.intersect_primitive(index, ray, t_max) {
                 best = Some((index, t, barycentrics));
@@ -228,38 +234,20 @@ impl Geometry {
 
     fn shade(&self, index: usize, ray: &Ray, t: f32, barycentrics: Vec2) -> Hit {
         let point = ray.at(t);
-        let shape = self.primitive_shapes[index];
-        let flip = if self.shape_flips[shape as usize] {
+        let source = self.sources[index];
+        let flip = if self.shape_flips[source.shape as usize] {
             -1.0
         } else {
             1.0
         };
-        let (geometric_normal, shading_normal) = match &self.primitives[index] {
-            Primitive::Sphere(s) => {
+        let (geometric_normal, shading_normal) = match &self.packed[index] {
+            Packed::Sphere(s) => {
                 let n = (point - s.center).normalize() * flip;
                 (n, n)
             }
-            Primitive::Triangle(triangle) => {
-                let n = triangle.normal().normalize() * flip;
-                let mesh = &self.meshes[triangle.mesh as usize];
-                let shading = match &mesh.normals {
-                    Some(normals) => {
-                        let [a, b, c] = mesh.triangles[triangle.index as usize];
-                        let interpolated = normals[a as usize]
-                            * (1.0 - barycentrics.x - barycentrics.y)
-                            + normals[b as usize] * barycentrics.x
-                            + normals[c as usize] * barycentrics.y;
-                        // Vertex normals were already flipped with the mesh.
-                        let s = interpolated.normalize_or_zero();
-                        if s == Vec3::ZERO {
-                            n
-                        } else {
-                            s
-                        }
-                    }
-                    None => n,
-                };
-                (n, shading)
+            triangle => {
+                let n = triangle.triangle_normal().unwrap_or(Vec3::Y).normalize() * flip;
+                (n, self.interpolated_normal(source, barycentrics).unwrap_or(n))
             }
         };
         Hit {
@@ -267,7 +255,45 @@ impl Geometry {
             point,
             geometric_normal,
             shading_normal,
-            shape,
+            shape: source.shape,
         }
     }
+
+    /// The vertex normals of a triangle's mesh interpolated at `barycentrics` (None: the mesh
+    /// has none, or they cancel out).
+    fn interpolated_normal(&self, source: PrimitiveSource, barycentrics: Vec2) -> Option<Vec3> {
+        let mesh = &self.meshes[source.mesh as usize];
+        let normals = mesh.normals.as_ref()?;
+        let [a, b, c] = mesh.triangles[source.index as usize];
+        let interpolated = normals[a as usize] * (1.0 - barycentrics.x - barycentrics.y)
+            + normals[b as usize] * barycentrics.x
+            + normals[c as usize] * barycentrics.y;
+        // Vertex normals were already flipped with the mesh.
+        let s = interpolated.normalize_or_zero();
+        (s != Vec3::ZERO).then_some(s)
+    }
+}
+
+/// Centre and radius of a sphere enclosing every primitive (zero for none).
+fn bounding_sphere(primitives: &[Primitive]) -> (Vec3, f32) {
+    let mut low = Vec3::splat(f32::INFINITY);
+    let mut high = Vec3::splat(f32::NEG_INFINITY);
+    for primitive in primitives {
+        match primitive {
+            Primitive::Triangle(t) => {
+                for v in t.vertices {
+                    low = low.min(v);
+                    high = high.max(v);
+                }
+            }
+            Primitive::Sphere(s) => {
+                low = low.min(s.center - s.radius);
+                high = high.max(s.center + s.radius);
+            }
+        }
+    }
+    if low.x > high.x {
+        return (Vec3::ZERO, 0.0);
+    }
+    ((low + high) * 0.5, (high - low).length() * 0.5)
 }

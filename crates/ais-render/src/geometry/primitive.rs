@@ -32,31 +32,77 @@ pub enum Primitive {
     Sphere(Sphere),
 }
 
+/// A primitive as traversal tests it, in the BVH's order: a triangle by its first vertex and
+/// two edges (36 bytes, computed once rather than per test), or a sphere. What shading needs
+/// (mesh, triangle index) lives elsewhere, so the hot array stays small.
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Packed {
+    /// A triangle: v0, v1 − v0, v2 − v0.
+    Triangle([Vec3; 3]),
+    /// A sphere.
+    Sphere(Sphere),
+}
+
+impl Packed {
+    /// The packed form of `primitive`.
+    pub(crate) fn new(primitive: &Primitive) -> Self {
+        match primitive {
+            Primitive::Triangle(t) => {
+                let [v0, v1, v2] = t.vertices;
+                Packed::Triangle([v0, v1 - v0, v2 - v0])
+            }
+            Primitive::Sphere(s) => Packed::Sphere(*s),
+        }
+    }
+
+    /// The distance and barycentrics (zero for a sphere) of the hit, if within the ray.
+    #[inline]
+    pub(crate) fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
+        match self {
+            Packed::Triangle([v0, e1, e2]) => moller_trumbore(*v0, *e1, *e2, ray, t_max),
+            Packed::Sphere(s) => s.intersect(ray, t_max).map(|t| (t, Vec2::ZERO)),
+        }
+    }
+
+    /// The unnormalised geometric normal of a triangle (e1 × e2).
+    pub(crate) fn triangle_normal(&self) -> Option<Vec3> {
+        match self {
+            Packed::Triangle([_, e1, e2]) => Some(e1.cross(*e2)),
+            Packed::Sphere(_) => None,
+        }
+    }
+}
+
+/// Möller-Trumbore with the edges given: the distance and barycentrics (b1, b2) of the hit,
+/// if within the ray.
+#[inline(always)]
+fn moller_trumbore(v0: Vec3, e1: Vec3, e2: Vec3, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
+    let p = ray.direction.cross(e2);
+        let determinant = e1.dot(p);
+    if determinant.abs() < 1e-20 {
+        return None;
+    }
+    let inverse = 1.0 / determinant;
+    let s = ray.origin - v0;
+    let b1 = s.dot(p) * inverse;
+    if !(0.0..=1.0).contains(&b1) {
+        return None;
+    }
+    let q = s.cross(e1);
+    let b2 = ray.direction.dot(q) * inverse;
+    if b2 < 0.0 || b1 + b2 > 1.0 {
+        return None;
+    }
+    let t = e2.dot(q) * inverse;
+    (t > 0.0 && t < t_max).then_some((t, Vec2::new(b1, b2)))
+}
+
 impl Triangle {
     /// Möller-Trumbore: the distance and barycentrics (b1, b2) of the hit, if within the ray.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
         let [v0, v1, v2] = self.vertices;
-        let e1 = v1 - v0;
-        let e2 = v2 - v0;
-        let p = ray.direction.cross(e2);
-        let determinant = e1.dot(p);
-        if determinant.abs() < 1e-20 {
-            return None;
-        }
-        let inverse = 1.0 / determinant;
-        let s = ray.origin - v0;
-        let b1 = s.dot(p) * inverse;
-        if !(0.0..=1.0).contains(&b1) {
-            return None;
-        }
-        let q = s.cross(e1);
-        let b2 = ray.direction.dot(q) * inverse;
-        if b2 < 0.0 || b1 + b2 > 1.0 {
-            return None;
-        }
-        let t = e2.dot(q) * inverse;
-        (t > 0.0 && t < t_max).then_some((t, Vec2::new(b1, b2)))
+        moller_trumbore(v0, v1 - v0, v2 - v0, ray, t_max)
     }
 
     /// The unnormalised geometric normal (e1 × e2), oriented by the winding.
