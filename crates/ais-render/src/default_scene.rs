@@ -7,7 +7,7 @@ use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Sphere};
 use crate::image_io::RgbImage;
-use crate::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights};
+use crate::lights::{AreaLight, AreaShape, Emitters, Environment, EnvironmentMap, Lights};
 use crate::mesh::TriangleMesh;
 use crate::scene::{look_at, CameraDescription, FovAxis, SceneDescription};
 use crate::shapes;
@@ -187,7 +187,15 @@ pub fn default_world(width: u32, height: u32) -> World {
         glam::DMat3::IDENTITY,
     )));
     let (_, scene_radius) = geometry.bounding_sphere();
-    let lights = Lights::new(Some(environment), area, 5, scene_radius as f64);
+    let lights = Lights::new(
+        Emitters {
+            environment: Some(environment),
+            area,
+            delta: Vec::new(),
+        },
+        5,
+        scene_radius as f64,
+    );
     let materials = vec![
         Material::diffuse(Vec3::splat(0.7)),
         Material::diffuse(Vec3::new(0.45, 0.42, 0.38)),

@@ -4,13 +4,12 @@ use crate::bsdf::Material;
 use crate::camera::Camera;
 use crate::error::InputError;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
-use crate::image_io::read_image;
-use crate::lights::{AreaLight, AreaShape, Environment, EnvironmentMap, Lights, Rectangle};
+use crate::lights::reader::{scene_emitters, spectrum_property};
+use crate::lights::{AreaLight, AreaShape, Emitters, Lights, Rectangle};
 use crate::mesh::{load_mesh, validate, TriangleMesh};
-use crate::scene::{self, Plugin, Property, SceneDescription};
+use crate::scene::{self, SceneDescription};
 use crate::shapes;
-use glam::{DMat3, Vec3};
-use std::path::Path;
+use glam::Vec3;
 
 /// Everything a render needs.
 pub struct World {
@@ -96,7 +95,7 @@ fn build_shape(
         .as_ref()
         .map(|e| {
             scene::warn_unknown(file, e, &["radiance"], warnings);
-            radiance_property(file, e, "radiance")
+            spectrum_property(file, e, "radiance")
         })
         .transpose()?;
     let mesh = match &shape.geometry {
@@ -169,24 +168,19 @@ impl World {
         crate::limits::check_geometry_memory(triangles)
             .map_err(|message| InputError::new(&file, message))?;
         let geometry = Geometry::build(inputs);
-        let environment = match description.emitters.as_slice() {
-            [] => None,
-            [one] => Some(environment(&file, &description.files, one, &mut warnings)?),
-            [_, second, ..] => {
-                return Err(InputError::at(
-                    &file,
-                    second.line,
-                    "only one scene-level emitter (envmap or constant) is supported",
-                ))
-            }
-        };
+        let (environment, delta) = scene_emitters(
+            &file,
+            &description.files,
+            &description.emitters,
+            &mut warnings,
+        )?;
         let (_, radius) = geometry.bounding_sphere();
-        let lights = Lights::new(
+        let emitters = Emitters {
             environment,
-            area_lights,
-            description.shapes.len(),
-            radius.max(1e-3) as f64,
-        );
+            area: area_lights,
+            delta,
+        };
+        let lights = Lights::new(emitters, description.shapes.len(), radius.max(1e-3) as f64);
         let (width, height) = description.resolution;
         Ok(World {
             geometry,
@@ -241,101 +235,4 @@ pub fn emitting_triangles(mesh: &TriangleMesh, flip_normals: bool) -> Vec<Triang
             }
         })
         .collect()
-}
-
-/// An rgb or float radiance property, which must be finite and non-negative; Mitsuba's
-/// default of 1 where it is not given.
-fn radiance_property(file: &Path, plugin: &Plugin, name: &str) -> Result<Vec3, InputError> {
-    let value = match plugin.properties.get(name).map(|p| &p.value) {
-        Some(Property::Rgb(c)) => Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32),
-        Some(Property::Float(v)) => Vec3::splat(*v as f32),
-        // Mitsuba's default radiance, for area and constant emitters alike.
-        None => Vec3::ONE,
-        Some(other) => {
-            return Err(InputError::at(
-                file,
-                plugin.line,
-                format!("{name} must be an rgb or float, not a {}", other.kind()),
-            ))
-        }
-    };
-    if !value.is_finite() || value.min_element() < 0.0 {
-        return Err(InputError::at(
-            file,
-            plugin.line,
-            format!("{name} must be finite and non-negative"),
-        ));
-    }
-    Ok(value)
-}
-
-/// A scene-level `envmap` or `constant` emitter.
-fn environment(
-    file: &Path,
-    files: &crate::scene::FileResolver,
-    plugin: &Plugin,
-    warnings: &mut Vec<String>,
-) -> Result<Environment, InputError> {
-    match plugin.kind.as_str() {
-        "constant" => {
-            scene::warn_unknown(file, plugin, &["radiance"], warnings);
-            Ok(Environment::Constant(radiance_property(
-                file, plugin, "radiance",
-            )?))
-        }
-        "envmap" => environment_map(file, files, plugin, warnings),
-        other => Err(InputError::at(
-            file,
-            plugin.line,
-            format!("emitter type \"{other}\" is not supported (envmap, constant, area)"),
-        )),
-    }
-}
-
-/// A scene-level `envmap`: the image found through `files`, scaled and rotated.
-fn environment_map(
-    file: &Path,
-    files: &crate::scene::FileResolver,
-    plugin: &Plugin,
-    warnings: &mut Vec<String>,
-) -> Result<Environment, InputError> {
-    let at = |(line, message): (u32, String)| InputError::at(file, line, message);
-    scene::warn_unknown(file, plugin, &["filename", "scale", "to_world"], warnings);
-    let name = plugin
-        .string("filename")
-        .map_err(at)?
-        .ok_or_else(|| InputError::at(file, plugin.line, "envmap needs a \"filename\""))?;
-    let loaded = read_image(&files.resolve(name))?;
-    warnings.extend(loaded.warning);
-    let scale = plugin.float("scale", 1.0).map_err(at)? as f32;
-    if !(scale.is_finite() && scale >= 0.0) {
-        return Err(InputError::at(
-            file,
-            plugin.line,
-            "envmap scale must be finite and non-negative",
-        ));
-    }
-    let mut image = loaded.image;
-    for p in &mut image.pixels {
-        *p = p.map(|c| c * scale);
-    }
-    if image
-        .pixels
-        .iter()
-        .flatten()
-        .any(|&c| c > crate::image_io::LARGEST_TEXEL)
-    {
-        return Err(InputError::at(
-            file,
-            plugin.line,
-            format!(
-                "envmap scale {scale:e} makes texels exceed {:e}",
-                crate::image_io::LARGEST_TEXEL
-            ),
-        ));
-    }
-    let rotation = DMat3::from_mat4(plugin.transform("to_world").map_err(at)?);
-    Ok(Environment::Map(Box::new(EnvironmentMap::new(
-        image, rotation,
-    ))))
 }

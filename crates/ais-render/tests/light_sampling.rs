@@ -12,7 +12,8 @@ use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
 use ais_render::integrators::gather::{GatherPoint, Strategy};
 use ais_render::lights::{
-    AreaLight, AreaShape, Environment, EnvironmentGuide, EnvironmentMap, Lights, Rectangle, Toward,
+    AreaLight, AreaShape, Emitters, Environment, EnvironmentGuide, EnvironmentMap, Lights,
+    Rectangle, Toward,
 };
 use base64::Engine;
 use glam::{DMat3, Vec3};
@@ -154,7 +155,14 @@ fn environment_guided_by_an_affinity_map_fits() {
         );
         assert!(p > SIGNIFICANCE, "fraction {fraction}: p = {p}");
     }
-    let lights = Lights::new(Some(Environment::Map(Box::new(map))), Vec::new(), 0, 10.0);
+    let lights = Lights::new(
+        Emitters {
+            environment: Some(Environment::Map(Box::new(map))),
+            ..Default::default()
+        },
+        0,
+        10.0,
+    );
     let material = Material::default();
     let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
     let wo = Vec3::new(-0.3, 0.2, 1.0).normalize();
@@ -308,7 +316,15 @@ fn mixed_lights() -> Lights {
         gradient_with_sun(32, 16),
         DMat3::IDENTITY,
     )));
-    Lights::new(Some(env), vec![rectangle_light(), sphere], 2, 3.0)
+    Lights::new(
+        Emitters {
+            environment: Some(env),
+            area: vec![rectangle_light(), sphere],
+            delta: Vec::new(),
+        },
+        2,
+        3.0,
+    )
 }
 
 #[test]

@@ -220,3 +220,50 @@ fn a_truncated_file_says_so() {
         .to_string();
     assert!(e.contains("is it truncated?"), "{e}");
 }
+
+#[test]
+fn emitter_errors_name_file_line_and_problem() {
+    let cases: &[(&str, &str)] = &[
+        ("<scene><emitter type=\"constant\"/>\n<emitter type=\"constant\"/></scene>", "test.xml:2: only one envmap or constant emitter"),
+        ("<scene>\n<emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"0\"/></emitter></scene>", "test.xml:2: spot angles must be finite"),
+        ("<scene>\n<emitter type=\"point\"><point name=\"position\" x=\"nan\" y=\"0\" z=\"0\"/></emitter></scene>", "test.xml:2: point emitter: position or direction is not finite"),
+        ("<scene>\n<emitter type=\"directional\"><vector name=\"direction\" x=\"0\" y=\"0\" z=\"0\"/></emitter></scene>", "test.xml:2: directional light has no direction"),
+        ("<scene>\n<emitter type=\"point\"><rgb name=\"intensity\" value=\"-1\"/></emitter></scene>", "test.xml:2: intensity must be finite and non-negative"),
+        ("<scene>\n<emitter type=\"projector\"/></scene>", "test.xml:2: emitter type \"projector\" is not supported"),
+    ];
+    for (text, expected) in cases {
+        let description = parse(text).expect("the file itself is well formed");
+        let Err(e) = ais_render::world::World::from_description(description) else {
+            panic!("{text} should be refused");
+        };
+        let message = e.to_string();
+        assert!(
+            message.contains(expected),
+            "for {text}\n got: {message}\n want: {expected}"
+        );
+    }
+}
+
+#[test]
+fn point_spot_and_directional_lights_take_mitsubas_defaults() {
+    let text = r#"<scene><emitter type="point"/><emitter type="spot"/>
+        <emitter type="directional"/><emitter type="constant"/></scene>"#;
+    let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
+    let lights = &world.lights.delta;
+    assert_eq!(lights.len(), 3);
+    let Some(arrival) = lights[0].arrival(DVec3::new(0.0, 2.0, 0.0).as_vec3()) else {
+        panic!("a point light reaches every point");
+    };
+    assert!((arrival.light - glam::Vec3::splat(0.25)).length() < 1e-6);
+    // The spot looks down +z with a 20° cutoff: on axis it sends all, at 30° nothing.
+    let on_axis = lights[1].arrival(glam::Vec3::new(0.0, 0.0, 1.0)).unwrap();
+    assert!((on_axis.light - glam::Vec3::ONE).length() < 1e-6);
+    let tilt = 30f32.to_radians();
+    assert!(lights[1]
+        .arrival(glam::Vec3::new(tilt.sin(), 0.0, tilt.cos()))
+        .is_none());
+    // The directional light travels along +z.
+    let sun = lights[2].arrival(glam::Vec3::ZERO).unwrap();
+    assert!((sun.direction + glam::Vec3::Z).length() < 1e-6);
+    assert_eq!(sun.distance, f32::INFINITY);
+}

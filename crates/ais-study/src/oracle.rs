@@ -121,12 +121,15 @@ impl Draw<'_> {
     /// support), found by a free visibility test.
     fn candidate(&mut self, u: [f32; 2]) -> Option<Vec3> {
         let at = self.at;
-        let (direction, pdf) = self.settings.strategy.sample(at, u).filter(|s| s.1 > 0.0)?;
-        if !at.material.in_support(&at.frame, at.wo, direction) {
+        let strategy = self.settings.strategy;
+        let mut toward = strategy.sample_direction(at, u)?;
+        let pdf = strategy.pdf(at, &mut toward);
+        let direction = toward.direction;
+        if pdf <= 0.0 || !at.material.in_support(&at.frame, at.wo, direction) {
             return None;
         }
         let mut test = RayCounts::default();
-        let actual = arriving_light(self.world, at, direction, &mut test);
+        let actual = arriving_light(self.world, at, &mut toward, &mut test);
         self.stats.free_tests += test.occlusion;
         (actual != Vec3::ZERO)
             .then(|| at.material.eval(&at.frame, at.wo, direction) * actual / pdf as f32)

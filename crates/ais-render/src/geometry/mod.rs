@@ -247,7 +247,10 @@ impl Geometry {
             }
             triangle => {
                 let n = triangle.triangle_normal().unwrap_or(Vec3::Y).normalize() * flip;
-                (n, self.interpolated_normal(source, barycentrics).unwrap_or(n))
+                (
+                    n,
+                    self.interpolated_normal(source, barycentrics).unwrap_or(n),
+                )
             }
         };
         Hit {

@@ -78,7 +78,7 @@ impl Packed {
 #[inline(always)]
 fn moller_trumbore(v0: Vec3, e1: Vec3, e2: Vec3, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
     let p = ray.direction.cross(e2);
-        let determinant = e1.dot(p);
+    let determinant = e1.dot(p);
     if determinant.abs() < 1e-20 {
         return None;
     }

@@ -1,14 +1,18 @@
-//! All emitters of a scene: an optional environment and area lights, chosen in proportion
-//! to their estimated power for light sampling (an alias table: O(1) per choice).
+//! All emitters of a scene: an optional environment, area lights and delta lights (point,
+//! spot, directional), chosen in proportion to their estimated power for light sampling (an
+//! alias table: O(1) per choice).
 
 mod area;
+mod delta;
 mod environment;
 mod environment_guide;
 mod mesh_emitter;
+pub(crate) mod reader;
 mod spherical_rectangle;
 mod toward;
 
 pub use area::{AreaLight, AreaSample, AreaShape};
+pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
 pub use mesh_emitter::MeshEmitter;
@@ -27,26 +31,40 @@ pub struct Lights {
     pub environment: Option<Environment>,
     /// Area lights.
     pub area: Vec<AreaLight>,
+    /// Point, spot and directional lights.
+    pub delta: Vec<DeltaLight>,
     /// For each geometry shape, its area light (index into `area`).
     pub shape_lights: Vec<Option<usize>>,
-    /// Choice of a light: index 0..area.len() for area lights, area.len() for the environment.
+    /// Choice of a light: area lights first, then delta lights, then the environment.
     choice: Option<AliasTable>,
+}
+
+/// A scene's emitters, before [`Lights::new`] weighs them.
+#[derive(Clone, Debug, Default)]
+pub struct Emitters {
+    /// The environment, if any.
+    pub environment: Option<Environment>,
+    /// Area lights.
+    pub area: Vec<AreaLight>,
+    /// Point, spot and directional lights.
+    pub delta: Vec<DeltaLight>,
 }
 
 impl Lights {
     /// Lights with selection weights from their power; the environment's power is taken as
     /// π · mean luminance · π R² for a scene of bounding radius `scene_radius`.
-    pub fn new(
-        environment: Option<Environment>,
-        area: Vec<AreaLight>,
-        shape_count: usize,
-        scene_radius: f64,
-    ) -> Self {
+    pub fn new(emitters: Emitters, shape_count: usize, scene_radius: f64) -> Self {
+        let Emitters {
+            environment,
+            area,
+            delta,
+        } = emitters;
         let mut shape_lights = vec![None; shape_count];
         for (index, light) in area.iter().enumerate() {
             shape_lights[light.shape_index as usize] = Some(index);
         }
         let mut weights: Vec<f64> = area.iter().map(AreaLight::power).collect();
+        weights.extend(delta.iter().map(|light| light.power(scene_radius)));
         if let Some(environment) = &environment {
             weights.push(PI * environment.mean_luminance() * PI * scene_radius * scene_radius);
         }
@@ -54,9 +72,15 @@ impl Lights {
         Lights {
             environment,
             area,
+            delta,
             shape_lights,
             choice,
         }
+    }
+
+    /// The environment's index in the choice of a light.
+    fn environment_index(&self) -> usize {
+        self.area.len() + self.delta.len()
     }
 
     /// Whether the scene has no emitter at all.
@@ -94,6 +118,10 @@ impl Lights {
             let sample = self.area[index].sample(point, [u0, u[1]])?;
             return Some(Toward::new(sample.direction));
         }
+        if index < self.environment_index() {
+            let delta = index - self.area.len();
+            return Some(Toward::delta(delta, self.delta[delta].arrival(point)?));
+        }
         match (self.environment.as_ref()?, guide) {
             (Environment::Map(map), Some(guide)) => Some(guide.sample(map, [u0, u[1]])),
             (environment, _) => Some(environment.sample_toward([u0, u[1]])),
@@ -120,6 +148,10 @@ impl Lights {
         toward: &mut Toward,
         guide: Option<&EnvironmentGuide>,
     ) -> f64 {
+        // A delta light is a point mass: only its choice counts, and no density adds to it.
+        if let Some((delta, _)) = toward.delta_light() {
+            return self.choice_probability(self.area.len() + delta);
+        }
         let mut pdf = 0.0;
         for (index, light) in self.area.iter().enumerate() {
             let p = self.choice_probability(index);
@@ -132,7 +164,7 @@ impl Lights {
                 (Environment::Map(map), Some(guide)) => guide.pdf(map, toward),
                 (environment, _) => environment.pdf_toward(toward),
             };
-            pdf += self.choice_probability(self.area.len()) * density;
+            pdf += self.choice_probability(self.environment_index()) * density;
         }
         pdf
     }
@@ -143,6 +175,9 @@ impl Lights {
     /// is the ray's direction, perhaps already located on the environment map.
     #[inline]
     pub fn unoccluded(&self, ray: &Ray, toward: &mut Toward) -> (Vec3, f32) {
+        if let Some((_, arrival)) = toward.delta_light() {
+            return (arrival.light, arrival.distance);
+        }
         let nearest = self
             .area
             .iter()

@@ -129,6 +129,30 @@ pub fn plane_under_a_sphere_light() -> (World, f64) {
     (scene_world("sphere-light", &xml, &[]), 0.3125)
 }
 
+/// A diffuse plane (reflectance 0.5) under a point light straight above (intensity 4 at
+/// height 2), a directional light at 60° from the normal (irradiance 2), a spot light aimed
+/// away from the plane and a constant sky of 0.2; the exact radiance toward the camera, and
+/// the part of it that BSDF sampling can find (the sky's).
+pub fn plane_under_delta_lights() -> (World, f64, f64) {
+    let xml = format!(
+        r#"<scene version="3.0.0">{}
+        <emitter type="constant"><rgb name="radiance" value="0.2"/></emitter>
+        <emitter type="point"><point name="position" x="0" y="0" z="2"/><rgb name="intensity" value="4"/></emitter>
+        <emitter type="directional"><vector name="direction" x="-0.8660254" y="0" z="-0.5"/>
+            <rgb name="irradiance" value="2"/></emitter>
+        <emitter type="spot"><transform name="to_world"><lookat origin="0, 0, 3" target="0, 0, 4" up="0, 1, 0"/></transform>
+            <rgb name="intensity" value="50"/></emitter>
+        <shape type="rectangle"><transform name="to_world"><scale value="10"/></transform>
+            <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape></scene>"#,
+        camera("3, 0, 1", "0, 0, 0", 0.01, 1)
+    );
+    let sky = 0.5 * 0.2;
+    // Irradiance: I / h² from the point light, E cos 60° from the directional light.
+    let (point, directional) = (4.0 / (2.0 * 2.0), 2.0 * 0.5);
+    let delta = 0.5 / std::f64::consts::PI * (point + directional);
+    (scene_world("delta-lights", &xml, &[]), sky + delta, sky)
+}
+
 /// A floor with a box on it under a sphere light, a rectangle light and a constant sky.
 pub fn occluded_scene() -> World {
     let xml = format!(

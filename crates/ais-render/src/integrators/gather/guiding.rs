@@ -78,6 +78,8 @@ impl<'a> CandidateSampler<'a> {
         let p = self.strategy.pdf(at, toward);
         match self.guide {
             None => p,
+            // A point mass of the strategy: the guide's density does not add to it.
+            Some(_) if toward.is_delta() => (1.0 - self.fraction as f64) * p,
             Some(guide) => {
                 let alpha = self.fraction as f64;
                 (1.0 - alpha) * p + alpha * guide.pdf(toward.direction) as f64

@@ -51,12 +51,13 @@ impl Leaving {
     }
 }
 
-/// Radiance arriving at the gather point from `direction`, occluders included.
+/// Light arriving at the gather point from a candidate direction, occluders included:
+/// radiance, or for a delta light its intensity over the squared distance (or irradiance).
 pub fn arriving_light(
     world: &World,
     at: &GatherPoint,
-    direction: Vec3,
+    toward: &mut Toward,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    Leaving::new(world, at, &mut Toward::new(direction)).trace(world, counts)
+    Leaving::new(world, at, toward).trace(world, counts)
 }

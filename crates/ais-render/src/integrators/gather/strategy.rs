@@ -131,7 +131,8 @@ impl Strategy {
         }
     }
 
-    /// The strategy's density at a direction.
+    /// The strategy's density at a direction; toward a delta light, the probability of
+    /// drawing that light (a point mass).
     #[inline]
     pub fn pdf(self, at: &GatherPoint, toward: &mut Toward) -> f64 {
         let light =
@@ -140,6 +141,9 @@ impl Strategy {
             Strategy::Uniform => 1.0 / (4.0 * PI),
             Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, toward.direction),
             Strategy::Light => light(toward),
+            // Toward a point, spot or directional light: a point mass of light sampling,
+            // which the BSDF's density does not add to.
+            Strategy::Mis if toward.is_delta() => (1.0 - MIS_BSDF_WEIGHT) * light(toward),
             Strategy::Mis => {
                 MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, toward.direction)
                     + (1.0 - MIS_BSDF_WEIGHT) * light(toward)
