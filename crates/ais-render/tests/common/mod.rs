@@ -148,7 +148,8 @@ pub fn plane_under_delta_lights() -> (World, f64, f64) {
     );
     let sky = 0.5 * 0.2;
     // Irradiance: I / h² from the point light, E cos 60° from the directional light.
-    let (point, directional) = (4.0 / (2.0 * 2.0), 2.0 * 0.5);
+    let (intensity, height, irradiance) = (4.0, 2.0, 2.0);
+    let (point, directional) = (intensity / (height * height), irradiance * 0.5);
     let delta = 0.5 / std::f64::consts::PI * (point + directional);
     (scene_world("delta-lights", &xml, &[]), sky + delta, sky)
 }
