@@ -13,7 +13,7 @@ use ais_render::image_io::{read_image, RgbImage};
 use ais_render::integrators::gather::{GatherPoint, Strategy};
 use ais_render::lights::{
     AreaLight, AreaShape, Emitters, Environment, EnvironmentGuide, EnvironmentMap, Lights,
-    Rectangle, Toward,
+    Receiver, Rectangle, Toward,
 };
 use base64::Engine;
 use glam::{DMat3, Vec3};
@@ -167,12 +167,11 @@ fn environment_guided_by_an_affinity_map_fits() {
     let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
     let wo = Vec3::new(-0.3, 0.2, 1.0).normalize();
     let at = GatherPoint {
-        point: Vec3::ZERO,
+        receiver: Receiver::guided(Vec3::ZERO, &guide),
         frame: ShadingFrame::new(&material, normal, normal, wo),
         wo,
         material: &material,
         lights: &lights,
-        environment_guide: Some(&guide),
     };
     for (seed, strategy) in [(22, Strategy::Light), (23, Strategy::Mis)] {
         let p = fit(
@@ -348,12 +347,11 @@ fn every_gather_proposal_fits() {
     let wo = Vec3::new(-0.3, 0.2, 1.0).normalize();
     let frame = ShadingFrame::new(&material, normal, normal, wo);
     let at = GatherPoint {
-        point: Vec3::ZERO,
+        receiver: Receiver::new(Vec3::ZERO),
         frame,
         wo,
         material: &material,
         lights: &lights,
-        environment_guide: None,
     };
     for (seed, strategy) in [
         Strategy::Uniform,

@@ -4,6 +4,7 @@
 
 use super::mesh_emitter::MeshEmitter;
 use super::spherical_rectangle::Rectangle;
+use super::Receiver;
 use crate::geometry::{Ray, Sphere, Triangle};
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -91,6 +92,13 @@ impl AreaLight {
 
     /// A direction toward the light from `point`.
     pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<AreaSample> {
+        self.sample_for(&Receiver::new(point), u)
+    }
+
+    /// [`AreaLight::sample`] for a receiver that keeps what its other queries can reuse.
+    #[inline]
+    pub fn sample_for(&self, receiver: &Receiver, u: [f32; 2]) -> Option<AreaSample> {
+        let point = receiver.point;
         match &self.shape {
             AreaShape::Sphere { sphere, .. } => {
                 let (axis, cos_max) = subtended_cone(sphere, point)?;
@@ -108,7 +116,8 @@ impl AreaLight {
                 })
             }
             AreaShape::Rectangle(rectangle) => {
-                let (direction, pdf) = rectangle.sample(point, u)?;
+                let view = receiver.rectangle_view(rectangle)?;
+                let (direction, pdf) = Rectangle::sample_view(&view, u);
                 Some(AreaSample { direction, pdf })
             }
             AreaShape::Triangles(mesh) => {
@@ -120,6 +129,13 @@ impl AreaLight {
 
     /// Density of [`AreaLight::sample`] at `direction` from `point`, in solid angle.
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
+        self.pdf_for(&Receiver::new(point), direction)
+    }
+
+    /// [`AreaLight::pdf`] for a receiver that keeps what its other queries can reuse.
+    #[inline]
+    pub fn pdf_for(&self, receiver: &Receiver, direction: Vec3) -> f64 {
+        let point = receiver.point;
         match &self.shape {
             AreaShape::Sphere { sphere, .. } => {
                 let Some((_, cos_max)) = subtended_cone(sphere, point) else {
@@ -136,7 +152,7 @@ impl AreaLight {
             }
             AreaShape::Rectangle(rectangle) => {
                 if rectangle.intersect(&Ray::new(point, direction)).is_some() {
-                    1.0 / rectangle.solid_angle(point)
+                    1.0 / Rectangle::view_solid_angle(receiver.rectangle_view(rectangle))
                 } else {
                     0.0
                 }

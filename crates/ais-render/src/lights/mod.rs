@@ -8,6 +8,7 @@ mod environment;
 mod environment_guide;
 mod mesh_emitter;
 pub(crate) mod reader;
+mod receiver;
 mod spherical_rectangle;
 mod toward;
 
@@ -16,6 +17,7 @@ pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
 pub use mesh_emitter::MeshEmitter;
+pub use receiver::Receiver;
 pub use spherical_rectangle::Rectangle;
 pub use toward::Toward;
 
@@ -99,30 +101,26 @@ impl Lights {
     /// power, then a direction toward it. Its density is [`Lights::pdf`] (all lights that
     /// could have produced it), which callers evaluate once.
     pub fn sample_direction(&self, point: Vec3, u: [f32; 2]) -> Option<Vec3> {
-        Some(self.sample_toward(point, u, None)?.direction)
+        Some(self.sample_toward(&Receiver::new(point), u)?.direction)
     }
 
-    /// [`Lights::sample_direction`], located on the environment map when drawn from it, with
-    /// the environment map sampled by `guide` (its product with an affinity map) when given;
-    /// the density is then [`Lights::pdf_toward`] with the same guide.
+    /// [`Lights::sample_direction`] for `receiver`, located on the environment map when drawn
+    /// from it, with the environment map sampled by the receiver's guide (its product with an
+    /// affinity map) when it has one; the density is then [`Lights::pdf_toward`].
     #[inline]
-    pub fn sample_toward(
-        &self,
-        point: Vec3,
-        u: [f32; 2],
-        guide: Option<&EnvironmentGuide>,
-    ) -> Option<Toward> {
+    pub fn sample_toward(&self, receiver: &Receiver, u: [f32; 2]) -> Option<Toward> {
         let choice = self.choice.as_ref()?;
         let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
-            let sample = self.area[index].sample(point, [u0, u[1]])?;
+            let sample = self.area[index].sample_for(receiver, [u0, u[1]])?;
             return Some(Toward::new(sample.direction));
         }
         if index < self.environment_index() {
             let delta = index - self.area.len();
-            return Some(Toward::delta(delta, self.delta[delta].arrival(point)?));
+            let arrival = self.delta[delta].arrival(receiver.point)?;
+            return Some(Toward::delta(delta, arrival));
         }
-        match (self.environment.as_ref()?, guide) {
+        match (self.environment.as_ref()?, receiver.environment_guide) {
             (Environment::Map(map), Some(guide)) => Some(guide.sample(map, [u0, u[1]])),
             (environment, _) => Some(environment.sample_toward([u0, u[1]])),
         }
@@ -137,17 +135,12 @@ impl Lights {
 
     /// Density of light sampling at `direction` from `point`, in solid angle.
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
-        self.pdf_toward(point, &mut Toward::new(direction), None)
+        self.pdf_toward(&Receiver::new(point), &mut Toward::new(direction))
     }
 
-    /// Density of [`Lights::sample_toward`] with the same `guide`.
+    /// Density of [`Lights::sample_toward`] for the same receiver.
     #[inline]
-    pub fn pdf_toward(
-        &self,
-        point: Vec3,
-        toward: &mut Toward,
-        guide: Option<&EnvironmentGuide>,
-    ) -> f64 {
+    pub fn pdf_toward(&self, receiver: &Receiver, toward: &mut Toward) -> f64 {
         // A delta light is a point mass: only its choice counts, and no density adds to it.
         if let Some((delta, _)) = toward.delta_light() {
             return self.choice_probability(self.area.len() + delta);
@@ -156,11 +149,11 @@ impl Lights {
         for (index, light) in self.area.iter().enumerate() {
             let p = self.choice_probability(index);
             if p > 0.0 {
-                pdf += p * light.pdf(point, toward.direction);
+                pdf += p * light.pdf_for(receiver, toward.direction);
             }
         }
         if let Some(environment) = &self.environment {
-            let density = match (environment, guide) {
+            let density = match (environment, receiver.environment_guide) {
                 (Environment::Map(map), Some(guide)) => guide.pdf(map, toward),
                 (environment, _) => environment.pdf_toward(toward),
             };

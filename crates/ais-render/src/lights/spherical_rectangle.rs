@@ -21,7 +21,8 @@ pub struct Rectangle {
 }
 
 /// The spherical rectangle seen from one point: everything the sampler needs.
-struct View {
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct View {
     x: glam::DVec3,
     y: glam::DVec3,
     z: glam::DVec3,
@@ -60,7 +61,8 @@ impl Rectangle {
         self.edge_x.cross(self.edge_y).length() as f64
     }
 
-    fn view(&self, point: Vec3) -> Option<View> {
+    /// How the rectangle looks from `point` (None: from its plane, or subtending nothing).
+    pub(crate) fn view(&self, point: Vec3) -> Option<View> {
         let origin = point.as_dvec3();
         let ex = self.edge_x.as_dvec3();
         let ey = self.edge_y.as_dvec3();
@@ -107,7 +109,11 @@ impl Rectangle {
 
     /// A direction from `point`, uniform over the subtended solid angle, and its density.
     pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
-        let v = self.view(point)?;
+        Some(Self::sample_view(&self.view(point)?, u))
+    }
+
+    /// [`Rectangle::sample`] from the point where `v` was seen.
+    pub(crate) fn sample_view(v: &View, u: [f32; 2]) -> (Vec3, f64) {
         let au = u[0] as f64 * v.solid_angle + v.k;
         let fu = (au.cos() * v.b0 - v.b1) / au.sin();
         let cu = (1.0 / (fu * fu + v.b0 * v.b0).sqrt())
@@ -126,12 +132,17 @@ impl Rectangle {
         };
         let target = v.origin + xu * v.x + yv * v.y + v.z0 * v.z;
         let direction = (target - v.origin).normalize().as_vec3();
-        Some((direction, 1.0 / v.solid_angle))
+        (direction, 1.0 / v.solid_angle)
     }
 
     /// The solid angle the rectangle subtends at `point` (0 in its plane).
     pub fn solid_angle(&self, point: Vec3) -> f64 {
         self.view(point).map_or(0.0, |v| v.solid_angle)
+    }
+
+    /// The solid angle it subtends where `view` was seen from (0 for no view).
+    pub(crate) fn view_solid_angle(view: Option<View>) -> f64 {
+        view.map_or(0.0, |v| v.solid_angle)
     }
 
     /// Distance along the ray to the rectangle, if it hits it (either side).

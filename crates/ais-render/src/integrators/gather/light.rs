@@ -23,7 +23,7 @@ impl Leaving {
     /// The ray leaving `at` toward a direction.
     #[inline]
     pub fn new(world: &World, at: &GatherPoint, toward: &mut Toward) -> Self {
-        let ray = spawn_ray(at.point, at.frame.geometric, toward.direction);
+        let ray = spawn_ray(at.receiver.point, at.frame.geometric, toward.direction);
         let (unoccluded, distance) = world.lights.unoccluded(&ray, toward);
         Leaving {
             ray,

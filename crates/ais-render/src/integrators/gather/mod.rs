@@ -236,7 +236,7 @@ fn guided_sampler<'g>(
     match guide.prepare(map, settings.strategy, at, settings.guide_fraction) {
         Guidance::Unguided => CandidateSampler::plain(settings.strategy),
         Guidance::Environment(environment) => {
-            at.environment_guide = Some(environment);
+            at.receiver.environment_guide = Some(environment);
             CandidateSampler::plain(settings.strategy)
         }
         Guidance::Mixture(distribution) => {

@@ -3,7 +3,7 @@
 
 use crate::bsdf::{Material, ShadingFrame};
 use crate::geometry::Hit;
-use crate::lights::{EnvironmentGuide, Lights, Toward};
+use crate::lights::{Lights, Receiver, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
@@ -51,8 +51,9 @@ pub const MIS_BSDF_WEIGHT: f64 = 0.5;
 
 /// Where a gather happens.
 pub struct GatherPoint<'a> {
-    /// The shading point.
-    pub point: Vec3,
+    /// The shading point, where light is received (with the environment guide of guided
+    /// gathers, and what the gather's light queries share).
+    pub receiver: Receiver<'a>,
     /// Its frame.
     pub frame: ShadingFrame,
     /// Direction toward the viewer.
@@ -61,21 +62,17 @@ pub struct GatherPoint<'a> {
     pub material: &'a Material,
     /// The scene's emitters.
     pub lights: &'a Lights,
-    /// Light sampling draws the environment from its product with this batch's fixed
-    /// affinity map (guided gathers), or from the environment alone (`None`).
-    pub environment_guide: Option<&'a EnvironmentGuide>,
 }
 
 /// The gather point where `hit` is seen from direction `wo` (pointing away from it).
 pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a> {
     let material = &world.materials[hit.shape as usize];
     GatherPoint {
-        point: hit.point,
+        receiver: Receiver::new(hit.point),
         frame: ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo),
         wo,
         material,
         lights: &world.lights,
-        environment_guide: None,
     }
 }
 
@@ -114,18 +111,15 @@ impl Strategy {
                 let (direction, pdf) = at.material.sample(&at.frame, at.wo, u);
                 (pdf > 0.0).then_some(Toward::new(direction))
             }
-            Strategy::Light => at.lights.sample_toward(at.point, u, at.environment_guide),
+            Strategy::Light => at.lights.sample_toward(&at.receiver, u),
             Strategy::Mis => {
                 let w = MIS_BSDF_WEIGHT as f32;
                 if u[0] < w {
                     let (direction, _) = at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]);
                     Some(Toward::new(direction))
                 } else {
-                    at.lights.sample_toward(
-                        at.point,
-                        [((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]],
-                        at.environment_guide,
-                    )
+                    let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
+                    at.lights.sample_toward(&at.receiver, [u0, u[1]])
                 }
             }
         }
@@ -135,8 +129,7 @@ impl Strategy {
     /// drawing that light (a point mass).
     #[inline]
     pub fn pdf(self, at: &GatherPoint, toward: &mut Toward) -> f64 {
-        let light =
-            |toward: &mut Toward| at.lights.pdf_toward(at.point, toward, at.environment_guide);
+        let light = |toward: &mut Toward| at.lights.pdf_toward(&at.receiver, toward);
         match self.effective(at) {
             Strategy::Uniform => 1.0 / (4.0 * PI),
             Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, toward.direction),

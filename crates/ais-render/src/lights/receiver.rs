@@ -1,0 +1,86 @@
+//! A point receiving light, and what the light queries of one gather there share.
+//!
+//! Every candidate of a gather starts at the same point. A rectangle light's spherical
+//! rectangle as seen from that point (four acos in f64, and the solid angle) is needed to
+//! sample it and for its density; a [`Receiver`] computes it once per light and keeps it for
+//! the gather's other candidates, in a few direct-mapped slots (no allocation).
+
+use super::spherical_rectangle::{Rectangle, View};
+use super::EnvironmentGuide;
+use glam::Vec3;
+use std::cell::Cell;
+
+/// How many rectangle lights' views a receiver keeps at once.
+const VIEW_SLOTS: usize = 4;
+
+/// A slot: the rectangle's address (its key within one scene's lights) and its view.
+type ViewSlot = Cell<Option<(usize, Option<View>)>>;
+
+/// A point where light is gathered.
+pub struct Receiver<'a> {
+    /// The point.
+    pub point: Vec3,
+    /// Light sampling draws the environment from its product with this guide (guided
+    /// gathers), or from the environment alone (`None`).
+    pub environment_guide: Option<&'a EnvironmentGuide>,
+    views: [ViewSlot; VIEW_SLOTS],
+}
+
+impl<'a> Receiver<'a> {
+    /// A receiver at `point`, unguided.
+    pub fn new(point: Vec3) -> Self {
+        Receiver {
+            point,
+            environment_guide: None,
+            views: Default::default(),
+        }
+    }
+
+    /// A receiver at `point` whose light sampling draws the environment through `guide`.
+    pub fn guided(point: Vec3, guide: &'a EnvironmentGuide) -> Self {
+        Receiver {
+            environment_guide: Some(guide),
+            ..Receiver::new(point)
+        }
+    }
+
+    /// How `rectangle` looks from the point (None: seen edge-on), computed on first use.
+    #[inline]
+    pub(super) fn rectangle_view(&self, rectangle: &Rectangle) -> Option<View> {
+        let key = rectangle as *const Rectangle as usize;
+        let slot = &self.views[(key / std::mem::align_of::<Rectangle>()) % VIEW_SLOTS];
+        if let Some((held, view)) = slot.get() {
+            if held == key {
+                return view;
+            }
+        }
+        let view = rectangle.view(self.point);
+        slot.set(Some((key, view)));
+        view
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_rectangle_gets_its_own_view_even_when_slots_collide() {
+        // More rectangles than slots, so some share a slot and must not see another's view.
+        let rectangles: Vec<Rectangle> = (0..3 * VIEW_SLOTS)
+            .map(|i| {
+                let corner = Vec3::new(i as f32 * 0.5 - 2.0, -0.5, 1.0 + i as f32 * 0.3);
+                Rectangle::new(corner, Vec3::X * (0.2 + i as f32 * 0.1), Vec3::Y, false)
+                    .expect("orthogonal edges")
+            })
+            .collect();
+        let point = Vec3::new(0.1, 0.2, 0.0);
+        let receiver = Receiver::new(point);
+        for round in 0..3 {
+            for (i, rectangle) in rectangles.iter().enumerate().rev().skip(round) {
+                let held = Rectangle::view_solid_angle(receiver.rectangle_view(rectangle));
+                assert_eq!(held, rectangle.solid_angle(point), "rectangle {i}");
+            }
+        }
+    }
+}
