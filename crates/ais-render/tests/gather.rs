@@ -76,6 +76,24 @@ fn plane_under_a_sphere_light_matches_the_analytic_irradiance() {
 }
 
 #[test]
+fn light_samples_reach_a_sphere_light_right_up_to_its_rim() {
+    // Far from the origin, shadow rays start well off the surface; one sent along the sampled
+    // direction to the sampled distance stops past the sphere's surface and loses the light
+    // (all of it, here; some of it near the rim anywhere). Light sampling of a sphere seen whole has almost no variance, so a small
+    // loss is many standard errors.
+    let (world, exact) = common::distant_plane_under_a_sphere_light();
+    for mode in [Preset::Off, Preset::Aggressive] {
+        let statistics = pixel_statistics(&world, settings(Strategy::Light, mode, 16), 16, 8);
+        let (mean, se) = (statistics.mean[0], statistics.se[0]);
+        let z = (mean - exact) / se.max(1e-4 * exact);
+        assert!(
+            z.abs() < 4.0,
+            "{mode:?}: {mean} ± {se} against {exact} (z {z:.1})"
+        );
+    }
+}
+
+#[test]
 fn point_spot_and_directional_lights_match_the_analytic_radiance() {
     let (world, exact, sky_only) = common::plane_under_delta_lights();
     for strategy in STRATEGIES {

@@ -178,7 +178,7 @@ fn environment_guided_by_an_affinity_map_fits() {
             200_000,
             seed,
             |u| strategy.sample(&at, u),
-            |d| strategy.pdf(&at, &mut Toward::new(d)),
+            |d| strategy.density(&at, d),
         );
         assert!(p > SIGNIFICANCE, "guided {strategy:?}: p = {p}");
     }
@@ -366,7 +366,7 @@ fn every_gather_proposal_fits() {
             200_000,
             10 + seed as u64,
             |u| strategy.sample(&at, u),
-            |d| strategy.pdf(&at, &mut Toward::new(d)),
+            |d| strategy.density(&at, d),
         );
         assert!(p > SIGNIFICANCE, "{strategy:?}: p = {p}");
     }

@@ -30,8 +30,12 @@ pub enum AreaShape {
 pub struct AreaSample {
     /// Unit direction from the receiver toward the light.
     pub direction: Vec3,
-    /// Density in solid angle at the receiver.
+    /// Density in solid angle at the receiver of drawing this point of the light.
     pub pdf: f64,
+    /// Distance from the receiver to the point drawn.
+    pub distance: f32,
+    /// The light's geometric normal there (toward its emitting side for a front face).
+    pub normal: Vec3,
 }
 
 /// An area light.
@@ -110,20 +114,48 @@ impl AreaLight {
                     + b * (sin_theta * phi.sin()) as f32
                     + axis * cos_theta as f32)
                     .normalize();
+                // The point drawn is where the direction meets the sphere; at the rim, f32
+                // may miss it, and then nothing was drawn.
+                let (distance, normal) = self.intersect(&Ray::new(point, direction))?;
                 Some(AreaSample {
                     direction,
                     pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+                    distance,
+                    normal,
                 })
             }
             AreaShape::Rectangle(rectangle) => {
                 let view = receiver.rectangle_view(rectangle)?;
-                let (direction, pdf) = Rectangle::sample_view(&view, u);
-                Some(AreaSample { direction, pdf })
+                let (direction, pdf, distance) = Rectangle::sample_view(&view, u);
+                Some(AreaSample {
+                    direction,
+                    pdf,
+                    distance,
+                    normal: rectangle.normal,
+                })
             }
-            AreaShape::Triangles(mesh) => {
-                let (direction, pdf) = mesh.sample(point, u)?;
-                Some(AreaSample { direction, pdf })
+            AreaShape::Triangles(mesh) => mesh.sample(point, u),
+        }
+    }
+
+    /// Light sampling's density (solid angle, this light alone) of drawing the point where a
+    /// ray from `receiver` along `direction` first meets the light, at `distance` with
+    /// geometric normal `normal`.
+    #[inline]
+    pub fn density_at(
+        &self,
+        receiver: &Receiver,
+        direction: Vec3,
+        distance: f32,
+        normal: Vec3,
+    ) -> f64 {
+        match &self.shape {
+            AreaShape::Sphere { sphere, .. } => subtended_cone(sphere, receiver.point)
+                .map_or(0.0, |(_, cos_max)| 1.0 / (2.0 * PI * (1.0 - cos_max))),
+            AreaShape::Rectangle(rectangle) => {
+                1.0 / Rectangle::view_solid_angle(receiver.rectangle_view(rectangle))
             }
+            AreaShape::Triangles(mesh) => mesh.density_at(direction, distance, normal),
         }
     }
 

@@ -237,7 +237,7 @@ impl EnvironmentMap {
             v: fast_trig::acos(cos_theta) * (1.0 / PI32),
             cell,
         };
-        Toward::located((self.to_world * local).normalize(), location)
+        Toward::from_environment((self.to_world * local).normalize(), Some(location))
     }
 
     /// The sampling density at `direction` (solid angle) and the cell it falls in.
@@ -298,7 +298,7 @@ impl Environment {
     #[inline]
     pub fn sample_toward(&self, u: [f32; 2]) -> Toward {
         match self {
-            Environment::Constant(_) => Toward::new(uniform_sphere(u)),
+            Environment::Constant(_) => Toward::from_environment(uniform_sphere(u), None),
             Environment::Map(map) => map.sample(u),
         }
     }

@@ -6,6 +6,7 @@
 //! each crossing point, and the gather takes the radiance of the nearest one, so the
 //! density of a direction is the sum over all its crossings of distance² / (|cos| · area).
 
+use super::AreaSample;
 use crate::geometry::{Ray, Triangle};
 use ais::sampling::AliasTable;
 use glam::Vec3;
@@ -54,10 +55,10 @@ impl MeshEmitter {
         self.area
     }
 
-    /// A direction from `point` toward a uniformly chosen point of the mesh, and its density
-    /// in solid angle for that triangle alone (the caller adds the other crossings through
-    /// [`MeshEmitter::pdf`] when it needs the full density).
-    pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
+    /// A direction from `point` toward a uniformly chosen point of the mesh, with the density
+    /// in solid angle of drawing that point ([`MeshEmitter::pdf`] sums it over every
+    /// crossing of the direction), its distance and the triangle's normal.
+    pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<AreaSample> {
         let (index, u0) = self.choice.sample(u[0]);
         let triangle = &self.triangles[index];
         let su = u0.sqrt();
@@ -70,8 +71,27 @@ impl MeshEmitter {
             return None;
         }
         let direction = offset.normalize();
-        let cosine = triangle.normal().normalize().dot(direction).abs() as f64;
-        (cosine > 0.0).then(|| (direction, distance_squared / (cosine * self.area)))
+        let normal = triangle.normal().normalize();
+        let distance = distance_squared.sqrt() as f32;
+        let pdf = self.density_at(direction, distance, normal);
+        (pdf > 0.0).then_some(AreaSample {
+            direction,
+            pdf,
+            distance,
+            normal,
+        })
+    }
+
+    /// The density in solid angle of drawing the point at `distance` along `direction`, on
+    /// a triangle of geometric normal `normal`: distance² / (|cos| · area).
+    #[inline]
+    pub fn density_at(&self, direction: Vec3, distance: f32, normal: Vec3) -> f64 {
+        let cosine = normal.dot(direction).abs() as f64;
+        if cosine > 0.0 {
+            (distance as f64).powi(2) / (cosine * self.area)
+        } else {
+            0.0
+        }
     }
 
     /// The density of [`MeshEmitter::sample`] toward `direction` from `point`: the sum over
@@ -85,10 +105,7 @@ impl MeshEmitter {
             |_, id| {
                 let triangle = &self.triangles[id];
                 if let Some((t, _)) = triangle.intersect(&ray, f32::INFINITY) {
-                    let cosine = triangle.normal().normalize().dot(direction).abs() as f64;
-                    if cosine > 0.0 {
-                        density += (t as f64).powi(2) / (cosine * self.area);
-                    }
+                    density += self.density_at(direction, t, triangle.normal().normalize());
                 }
                 // Never shorten the ray: every crossing counts.
                 f32::INFINITY

@@ -20,6 +20,7 @@ pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
 pub use spherical_rectangle::Rectangle;
 pub use toward::Toward;
+use toward::{AreaPoint, Source};
 
 use crate::geometry::Ray;
 use ais::sampling::AliasTable;
@@ -98,22 +99,28 @@ impl Lights {
     }
 
     /// A direction from `point` drawn by light sampling: a light chosen in proportion to its
-    /// power, then a direction toward it. Its density is [`Lights::pdf`] (all lights that
-    /// could have produced it), which callers evaluate once.
+    /// power, then a direction toward it. Its density over directions is [`Lights::pdf`].
     pub fn sample_direction(&self, point: Vec3, u: [f32; 2]) -> Option<Vec3> {
         Some(self.sample_toward(&Receiver::new(point), u)?.direction)
     }
 
-    /// [`Lights::sample_direction`] for `receiver`, located on the environment map when drawn
-    /// from it, with the environment map sampled by the receiver's guide (its product with an
-    /// affinity map) when it has one; the density is then [`Lights::pdf_toward`].
+    /// [`Lights::sample_direction`] for `receiver`, knowing what it was drawn toward (a point
+    /// of an area light, the environment with its place on the map, a delta light), with the
+    /// environment map sampled by the receiver's guide (its product with an affinity map)
+    /// when it has one.
     #[inline]
     pub fn sample_toward(&self, receiver: &Receiver, u: [f32; 2]) -> Option<Toward> {
         let choice = self.choice.as_ref()?;
         let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
-            let sample = self.area[index].sample_for(receiver, [u0, u[1]])?;
-            return Some(Toward::new(sample.direction));
+            let light = &self.area[index];
+            let sample = light.sample_for(receiver, [u0, u[1]])?;
+            let point = AreaPoint {
+                target: receiver.point + sample.direction * sample.distance,
+                radiance: light.emitted(sample.normal, sample.direction),
+                density: self.choice_probability(index) * sample.pdf,
+            };
+            return Some(Toward::area(sample.direction, point));
         }
         if index < self.environment_index() {
             let delta = index - self.area.len();
@@ -126,66 +133,114 @@ impl Lights {
         }
     }
 
-    /// [`Lights::sample_direction`] with its density.
+    /// [`Lights::sample_direction`] with its density over directions.
     pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
         let direction = self.sample_direction(point, u)?;
         let pdf = self.pdf(point, direction);
         (pdf > 0.0).then_some((direction, pdf))
     }
 
-    /// Density of light sampling at `direction` from `point`, in solid angle.
+    /// Density of light sampling over directions at `direction` from `point`, in solid
+    /// angle: every light that could have drawn it, and every crossing of an emitting mesh.
+    /// This is what [`Lights::sample_direction`] draws from; the gather weighs a candidate by
+    /// [`Lights::pdf_toward`] instead.
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
-        self.pdf_toward(&Receiver::new(point), &mut Toward::new(direction))
+        self.pdf_over_directions(&Receiver::new(point), direction)
     }
 
-    /// Density of [`Lights::sample_toward`] for the same receiver.
-    #[inline]
-    pub fn pdf_toward(&self, receiver: &Receiver, toward: &mut Toward) -> f64 {
-        // A delta light is a point mass: only its choice counts, and no density adds to it.
-        if let Some((delta, _)) = toward.delta_light() {
-            return self.choice_probability(self.area.len() + delta);
-        }
+    /// [`Lights::pdf`] for `receiver` (with its environment guide, if any).
+    pub fn pdf_over_directions(&self, receiver: &Receiver, direction: Vec3) -> f64 {
         let mut pdf = 0.0;
         for (index, light) in self.area.iter().enumerate() {
             let p = self.choice_probability(index);
             if p > 0.0 {
-                pdf += p * light.pdf_for(receiver, toward.direction);
+                pdf += p * light.pdf_for(receiver, direction);
             }
         }
-        if let Some(environment) = &self.environment {
-            let density = match (environment, receiver.environment_guide) {
-                (Environment::Map(map), Some(guide)) => guide.pdf(map, toward),
-                (environment, _) => environment.pdf_toward(toward),
-            };
-            pdf += self.choice_probability(self.environment_index()) * density;
-        }
-        pdf
+        pdf + self.environment_density(receiver, &mut Toward::new(direction))
     }
 
-    /// Radiance arriving along the ray from the first emitter, ignoring every occluder that
-    /// is not an emitter, and the distance to that emitter (infinite for the environment):
-    /// what the ray would bring if nothing blocked it, and how far it must be free. `toward`
-    /// is the ray's direction, perhaps already located on the environment map.
+    /// The density with which light sampling draws what `toward` meets first: the point of
+    /// an area light, the environment in that direction, or (a point mass) a delta light.
+    /// Light sampling draws other points along the direction too, behind the first; they
+    /// bring nothing, as what lies in front occludes them, so this density, not the sum
+    /// over every way of drawing the direction, gives each candidate its unbiased weight
+    /// (as Mitsuba's direct integrator weighs its emitter samples). It needs no loop over
+    /// the lights for a direction drawn by light sampling.
     #[inline]
-    pub fn unoccluded(&self, ray: &Ray, toward: &mut Toward) -> (Vec3, f32) {
-        if let Some((_, arrival)) = toward.delta_light() {
-            return (arrival.light, arrival.distance);
+    pub fn pdf_toward(&self, receiver: &Receiver, toward: &mut Toward) -> f64 {
+        self.resolve(receiver, toward);
+        match toward.source {
+            Source::Delta(delta, _) => self.choice_probability(self.area.len() + delta),
+            Source::Area(point) => point.density,
+            Source::Environment => self.environment_density(receiver, toward),
+            Source::Dark | Source::Unknown => 0.0,
         }
+    }
+
+    /// Light sampling's density of the environment at `toward` (choice included).
+    fn environment_density(&self, receiver: &Receiver, toward: &mut Toward) -> f64 {
+        let Some(environment) = &self.environment else {
+            return 0.0;
+        };
+        let density = match (environment, receiver.environment_guide) {
+            (Environment::Map(map), Some(guide)) => guide.pdf(map, toward),
+            (environment, _) => environment.pdf_toward(toward),
+        };
+        self.choice_probability(self.environment_index()) * density
+    }
+
+    /// What `toward` brings to `receiver` if nothing that does not emit is in the way, and
+    /// the point the ray must be free to: the radiance of the first emitter along it and
+    /// its point (`None`, unbounded, for the environment and a directional light), or a
+    /// delta light's light and position.
+    #[inline]
+    pub fn unoccluded(&self, receiver: &Receiver, toward: &mut Toward) -> (Vec3, Option<Vec3>) {
+        self.resolve(receiver, toward);
+        match toward.source {
+            Source::Delta(_, arrival) => {
+                let target = arrival
+                    .distance
+                    .is_finite()
+                    .then(|| receiver.point + arrival.direction * arrival.distance);
+                (arrival.light, target)
+            }
+            Source::Area(point) => (point.radiance, Some(point.target)),
+            Source::Environment => {
+                let environment = self.environment.as_ref();
+                let radiance = environment.map_or(Vec3::ZERO, |e| e.radiance_toward(toward));
+                (radiance, None)
+            }
+            Source::Dark | Source::Unknown => (Vec3::ZERO, None),
+        }
+    }
+
+    /// Finds what a direction of unknown source meets first among the emitters: the nearest
+    /// area light along it, else the environment.
+    fn resolve(&self, receiver: &Receiver, toward: &mut Toward) {
+        if !matches!(toward.source, Source::Unknown) {
+            return;
+        }
+        let ray = Ray::new(receiver.point, toward.direction);
         let nearest = self
             .area
             .iter()
-            .filter_map(|light| light.intersect(ray).map(|(t, n)| (t, n, light)))
+            .enumerate()
+            .filter_map(|(index, light)| light.intersect(&ray).map(|(t, n)| (t, n, index)))
             .min_by(|a, b| a.0.total_cmp(&b.0));
-        match nearest {
-            Some((t, normal, light)) => (light.emitted(normal, ray.direction), t),
-            None => {
-                let background = self
-                    .environment
-                    .as_ref()
-                    .map_or(Vec3::ZERO, |e| e.radiance_toward(toward));
-                (background, f32::INFINITY)
+        toward.source = match nearest {
+            Some((distance, normal, index)) => {
+                let light = &self.area[index];
+                let density = light.density_at(receiver, toward.direction, distance, normal);
+                Source::Area(AreaPoint {
+                    target: receiver.point + toward.direction * distance,
+                    radiance: light.emitted(normal, toward.direction),
+                    density: self.choice_probability(index) * density,
+                })
             }
-        }
+            None if self.environment.is_some() => Source::Environment,
+            None => Source::Dark,
+        };
     }
 
     /// Radiance of the environment in `direction` (black without one).

@@ -26,7 +26,6 @@ pub(crate) struct View {
     x: glam::DVec3,
     y: glam::DVec3,
     z: glam::DVec3,
-    origin: glam::DVec3,
     x0: f64,
     x1: f64,
     y0: f64,
@@ -94,7 +93,6 @@ impl Rectangle {
             x,
             y,
             z,
-            origin,
             x0,
             x1,
             y0,
@@ -109,11 +107,13 @@ impl Rectangle {
 
     /// A direction from `point`, uniform over the subtended solid angle, and its density.
     pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<(Vec3, f64)> {
-        Some(Self::sample_view(&self.view(point)?, u))
+        let (direction, pdf, _) = Self::sample_view(&self.view(point)?, u);
+        Some((direction, pdf))
     }
 
-    /// [`Rectangle::sample`] from the point where `v` was seen.
-    pub(crate) fn sample_view(v: &View, u: [f32; 2]) -> (Vec3, f64) {
+    /// [`Rectangle::sample`] from the point where `v` was seen, with the distance to the
+    /// point drawn.
+    pub(crate) fn sample_view(v: &View, u: [f32; 2]) -> (Vec3, f64, f32) {
         let au = u[0] as f64 * v.solid_angle + v.k;
         let fu = (au.cos() * v.b0 - v.b1) / au.sin();
         let cu = (1.0 / (fu * fu + v.b0 * v.b0).sqrt())
@@ -130,9 +130,13 @@ impl Rectangle {
         } else {
             v.y1
         };
-        let target = v.origin + xu * v.x + yv * v.y + v.z0 * v.z;
-        let direction = (target - v.origin).normalize().as_vec3();
-        (direction, 1.0 / v.solid_angle)
+        let offset = xu * v.x + yv * v.y + v.z0 * v.z;
+        let distance = offset.length();
+        (
+            (offset / distance).as_vec3(),
+            1.0 / v.solid_angle,
+            distance as f32,
+        )
     }
 
     /// The solid angle the rectangle subtends at `point` (0 in its plane).

@@ -1,44 +1,83 @@
-//! A direction toward the lights that remembers where it falls on the environment map.
+//! A candidate direction toward the lights, and what it is known to meet there.
 //!
-//! A traced candidate asks the environment for its density and then for its radiance; a
-//! light-sampled one was drawn from a cell that is already known. Locating a direction on a
-//! lat-long map costs an atan2, an acos and a rotation, so a [`Toward`] does it at most once
-//! and carries the result to every later lookup. A direction drawn toward a point, spot or
-//! directional light carries that light too: its probability is a point mass, not a density.
+//! The gather weighs a candidate by the density of drawing what the candidate sees first:
+//! the point of an area light, the environment, or a delta light. A direction drawn by light
+//! sampling knows its source already (the point drawn on an area light, the environment's
+//! cell, the delta light); a direction drawn from the BSDF finds it once, by a query of the
+//! emitters along it, and keeps it for the density and the radiance. Locating a direction on
+//! a lat-long map costs an atan2, an acos and a rotation, so that too is done at most once.
 
 use super::delta::DeltaArrival;
 use super::environment::{EnvironmentMap, MapLocation};
 use glam::Vec3;
 
-/// A unit world-space direction, and its place on the scene's environment map once known.
+/// What a candidate direction meets first among the emitters.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Source {
+    /// Not known yet: found by [`super::Lights`] when first needed.
+    Unknown,
+    /// The environment: nothing that emits lies along the direction before it.
+    Environment,
+    /// A point of an area light.
+    Area(AreaPoint),
+    /// A point, spot or directional light (its index among the scene's delta lights).
+    Delta(usize, DeltaArrival),
+    /// Nothing emits along the direction.
+    Dark,
+}
+
+/// The point of an area light that a candidate direction meets.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct AreaPoint {
+    /// Where it is (world space).
+    pub target: Vec3,
+    /// Radiance it sends toward the receiver (zero from its back side).
+    pub radiance: Vec3,
+    /// Light sampling's density of drawing this point, in solid angle at the receiver,
+    /// including the choice of the light.
+    pub density: f64,
+}
+
+/// A unit world-space direction, with what it meets and its place on the environment map
+/// once known.
 #[derive(Clone, Copy, Debug)]
 pub struct Toward {
     /// The direction (unit, world space).
     pub direction: Vec3,
     /// Where it falls on the environment map, once located.
     on_map: Option<MapLocation>,
-    /// The delta light it was drawn toward (its index among the scene's delta lights).
-    delta: Option<(usize, DeltaArrival)>,
+    /// What it meets first among the emitters, once known.
+    pub(super) source: Source,
 }
 
 impl Toward {
-    /// A direction not yet located.
+    /// A direction whose source is not known yet (drawn from a BSDF, say).
     #[inline]
     pub fn new(direction: Vec3) -> Self {
         Toward {
             direction,
             on_map: None,
-            delta: None,
+            source: Source::Unknown,
         }
     }
 
-    /// A direction whose place on the map is known (it was drawn there).
+    /// A direction drawn from the environment, with its place on the map when it has one.
     #[inline]
-    pub(super) fn located(direction: Vec3, location: MapLocation) -> Self {
+    pub(super) fn from_environment(direction: Vec3, location: Option<MapLocation>) -> Self {
         Toward {
             direction,
-            on_map: Some(location),
-            delta: None,
+            on_map: location,
+            source: Source::Environment,
+        }
+    }
+
+    /// A direction drawn toward a point of an area light.
+    #[inline]
+    pub(super) fn area(direction: Vec3, point: AreaPoint) -> Self {
+        Toward {
+            direction,
+            on_map: None,
+            source: Source::Area(point),
         }
     }
 
@@ -48,7 +87,7 @@ impl Toward {
         Toward {
             direction: arrival.direction,
             on_map: None,
-            delta: Some((index, arrival)),
+            source: Source::Delta(index, arrival),
         }
     }
 
@@ -56,13 +95,7 @@ impl Toward {
     /// then a point mass, which no density (BSDF, guide) adds to.
     #[inline]
     pub fn is_delta(&self) -> bool {
-        self.delta.is_some()
-    }
-
-    /// The delta light it was drawn toward, and what that light sends.
-    #[inline]
-    pub(super) fn delta_light(&self) -> Option<(usize, DeltaArrival)> {
-        self.delta
+        matches!(self.source, Source::Delta(..))
     }
 
     /// Its place on `map` (a scene has one environment), located on first use.

@@ -129,6 +129,20 @@ pub fn plane_under_a_sphere_light() -> (World, f64) {
     (scene_world("sphere-light", &xml, &[]), 0.3125)
 }
 
+/// [`plane_under_a_sphere_light`] moved 300 units from the origin, where a ray's offset
+/// from its surface is 300 times larger; the exact radiance toward the camera.
+pub fn distant_plane_under_a_sphere_light() -> (World, f64) {
+    let xml = format!(
+        r#"<scene version="3.0.0">{}
+        <shape type="rectangle"><transform name="to_world"><scale value="10"/><translate x="300"/></transform>
+            <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf></shape>
+        <shape type="sphere"><point name="center" x="300" y="0" z="2"/><float name="radius" value="0.5"/>
+            <emitter type="area"><rgb name="radiance" value="10"/></emitter></shape></scene>"#,
+        camera("303, 0, 1", "300, 0, 0", 0.01, 1)
+    );
+    (scene_world("distant-sphere-light", &xml, &[]), 0.3125)
+}
+
 /// A diffuse plane (reflectance 0.5) under a point light straight above (intensity 4 at
 /// height 2), a directional light at 60° from the normal (irradiance 2), a spot light aimed
 /// away from the plane and a constant sky of 0.2; the exact radiance toward the camera, and

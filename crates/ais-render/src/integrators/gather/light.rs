@@ -2,7 +2,7 @@
 //! nothing in the way, and what the occlusion ray lets through.
 
 use super::strategy::GatherPoint;
-use crate::geometry::{spawn_ray, Ray};
+use crate::geometry::{spawn_ray, spawn_ray_to, Ray};
 use crate::lights::Toward;
 use crate::render::RayCounts;
 use crate::world::World;
@@ -11,25 +11,27 @@ use glam::Vec3;
 /// The ray leaving a gather point toward a candidate direction, before it is traced.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Leaving {
-    /// The ray, offset from the surface.
+    /// The ray, offset from the surface, ending just short of the light's point (unbounded
+    /// toward the environment or a directional light).
     ray: Ray,
     /// The radiance it would bring if nothing blocked it.
     pub unoccluded: Vec3,
-    /// How far it must be free (infinite toward the environment).
-    distance: f32,
 }
 
 impl Leaving {
     /// The ray leaving `at` toward a direction.
     #[inline]
     pub fn new(world: &World, at: &GatherPoint, toward: &mut Toward) -> Self {
-        let ray = spawn_ray(at.receiver.point, at.frame.geometric, toward.direction);
-        let (unoccluded, distance) = world.lights.unoccluded(&ray, toward);
-        Leaving {
-            ray,
-            unoccluded,
-            distance,
-        }
+        let (unoccluded, target) = world.lights.unoccluded(&at.receiver, toward);
+        let (point, normal) = (at.receiver.point, at.frame.geometric);
+        // Aimed at the light's point from the offset origin, so that the ray ends just short
+        // of it whatever the offset (a ray along the direction from the offset origin can
+        // meet a curved light well before the point, near its rim).
+        let ray = match target {
+            Some(target) => spawn_ray_to(point, normal, target),
+            None => spawn_ray(point, normal, toward.direction),
+        };
+        Leaving { ray, unoccluded }
     }
 
     /// What the ray actually brings: its unoccluded radiance, or zero if blocked. Only rays
@@ -39,9 +41,7 @@ impl Leaving {
         if self.unoccluded == Vec3::ZERO {
             return Vec3::ZERO;
         }
-        let mut ray = self.ray;
-        // The emitter's own surface is in the BVH: stop just short of it.
-        ray.t_max = self.distance * (1.0 - 1e-4);
+        let ray = self.ray;
         counts.occlusion += 1;
         if world.geometry.occluded(&ray) {
             Vec3::ZERO

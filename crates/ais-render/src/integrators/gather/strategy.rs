@@ -86,15 +86,31 @@ impl Strategy {
         }
     }
 
-    /// A candidate direction and the strategy's density there (`None`: no direction, a zero).
+    /// A candidate direction and the strategy's density over directions there (`None`: no
+    /// direction, a zero). The gather weighs candidates by [`Strategy::pdf`] instead, which
+    /// counts only what a direction meets first; this is the distribution it draws from.
     pub fn sample(self, at: &GatherPoint, u: [f32; 2]) -> Option<(Vec3, f64)> {
         match self.effective(at) {
             Strategy::Uniform => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
             Strategy::Bsdf => Some(at.material.sample(&at.frame, at.wo, u)),
             Strategy::Light | Strategy::Mis => {
-                let mut toward = self.sample_direction(at, u)?;
-                let pdf = self.pdf(at, &mut toward);
-                (pdf > 0.0).then_some((toward.direction, pdf))
+                let direction = self.sample_direction(at, u)?.direction;
+                let pdf = self.density(at, direction);
+                (pdf > 0.0).then_some((direction, pdf))
+            }
+        }
+    }
+
+    /// The density over directions of [`Strategy::sample`] at `direction`, in solid angle.
+    pub fn density(self, at: &GatherPoint, direction: Vec3) -> f64 {
+        let light = || at.lights.pdf_over_directions(&at.receiver, direction);
+        match self.effective(at) {
+            Strategy::Uniform => 1.0 / (4.0 * PI),
+            Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, direction),
+            Strategy::Light => light(),
+            Strategy::Mis => {
+                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, direction)
+                    + (1.0 - MIS_BSDF_WEIGHT) * light()
             }
         }
     }
@@ -125,8 +141,9 @@ impl Strategy {
         }
     }
 
-    /// The strategy's density at a direction; toward a delta light, the probability of
-    /// drawing that light (a point mass).
+    /// The density that weighs a candidate: the strategy's density of drawing what the
+    /// direction meets first ([`crate::lights::Lights::pdf_toward`]); toward a delta light,
+    /// the probability of drawing that light (a point mass).
     #[inline]
     pub fn pdf(self, at: &GatherPoint, toward: &mut Toward) -> f64 {
         let light = |toward: &mut Toward| at.lights.pdf_toward(&at.receiver, toward);
