@@ -5,7 +5,7 @@ use crate::default_scene::default_world;
 use crate::error::InputError;
 use crate::integrators::gather::settings::PARAMETERS;
 use crate::integrators::gather::GatherSettings;
-use crate::scene::{load_scene, parse_scene};
+use crate::scene::{load_scene, parse_scene, Plugin};
 use crate::world::World;
 use std::path::Path;
 
@@ -93,13 +93,19 @@ pub fn gather_settings(
 ) -> Result<GatherSettings, String> {
     let file = world.description.file.display();
     let at = |(line, message): (u32, String)| format!("{file}:{line}: {message}");
-    let mut settings = match &world.description.integrator {
+    let integrator = world
+        .description
+        .integrator
+        .as_ref()
+        .map(|plugin| rendering_integrator(plugin, &file, warnings));
+    let mut settings = match integrator {
         Some(plugin) if plugin.kind == "gather" => {
             GatherSettings::from_properties(plugin).map_err(at)?
         }
-        Some(plugin) if plugin.kind == "direct" || plugin.kind == "path" => {
+        Some(plugin) => {
             warnings.push(format!(
-                "{file}:{}: integrator \"{}\" rendered with ais's gather (MIS, direct light only)",
+                "{file}:{}: integrator \"{}\" rendered with ais's gather (MIS): direct light \
+                 only, indirect light is not computed",
                 plugin.line, plugin.kind
             ));
             let read = GatherSettings::from_mitsuba_integrator(plugin).map_err(at)?;
@@ -110,12 +116,6 @@ pub fn gather_settings(
                 )
             }));
             read.settings
-        }
-        Some(plugin) => {
-            return Err(format!(
-                "{file}:{}: integrator \"{}\" is not supported (gather, direct, path)",
-                plugin.line, plugin.kind
-            ))
         }
         None => GatherSettings::default(),
     };
@@ -135,6 +135,28 @@ pub fn gather_settings(
     }
     settings.validate()?;
     Ok(settings)
+}
+
+/// The integrator that renders: Mitsuba's `moment` and `aov` wrap another, which renders
+/// in their place (with a warning: their extra outputs are not written).
+fn rendering_integrator<'a>(
+    plugin: &'a Plugin,
+    file: &impl std::fmt::Display,
+    warnings: &mut Vec<String>,
+) -> &'a Plugin {
+    let mut current = plugin;
+    while matches!(current.kind.as_str(), "moment" | "aov") {
+        let Some(inner) = current.children.iter().find(|c| c.tag == "integrator") else {
+            break;
+        };
+        warnings.push(format!(
+            "{file}:{}: integrator \"{}\" is unwrapped: its inner \"{}\" renders, and its \
+             extra channels are not written",
+            current.line, current.kind, inner.kind
+        ));
+        current = inner;
+    }
+    current
 }
 
 /// Settings from a configuration text of `name=value` words (the gather's parameter names),

@@ -267,3 +267,41 @@ fn point_spot_and_directional_lights_take_mitsubas_defaults() {
     assert!((sun.direction + glam::Vec3::Z).length() < 1e-6);
     assert_eq!(sun.distance, f32::INFINITY);
 }
+
+#[test]
+fn any_mitsuba_integrator_renders_as_the_gather_with_a_warning() {
+    let cases: &[(&str, &[&str], bool)] = &[
+        (
+            r#"<scene><integrator type="volpath"><integer name="max_depth" value="8"/></integrator></scene>"#,
+            &[
+                "integrator \"volpath\" rendered with ais's gather (MIS): direct light only",
+                "\"max_depth\" of integrator \"volpath\" is ignored",
+            ],
+            false,
+        ),
+        (
+            r#"<scene><integrator type="aov"><string name="aovs" value="nn:sh_normal"/>
+                <integrator type="path"><boolean name="hide_emitters" value="true"/></integrator>
+            </integrator></scene>"#,
+            &[
+                "integrator \"aov\" is unwrapped: its inner \"path\" renders",
+                "integrator \"path\" rendered with ais's gather",
+            ],
+            true,
+        ),
+    ];
+    for (text, expected, hidden) in cases {
+        let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
+        let mut warnings = Vec::new();
+        let settings =
+            ais_render::request::gather_settings(&world, &[], str::to_string, &mut warnings)
+                .unwrap();
+        assert_eq!(settings.hide_emitters, *hidden, "{text}");
+        for want in *expected {
+            assert!(
+                warnings.iter().any(|w| w.contains(want)),
+                "{want} missing from {warnings:?}"
+            );
+        }
+    }
+}
