@@ -9,12 +9,15 @@ a flat (uncompressed) Radiance RGBE image. It also writes, into the same folder:
 - blob.obj: a bumpy sphere of radius about 1 with 14,800 triangles, the sunlit room's mesh;
 - leaves.obj: 4,000 small square leaves (8,000 triangles) scattered with a fixed seed through
   a slab 4 x 0.8 x 4 m, a canopy that occludes partly at every scale;
-- ball.obj: a smooth sphere of radius 1 with 7,920 triangles, an emitting mesh.
+- ball.obj: a smooth sphere of radius 1 with 7,920 triangles, an emitting mesh;
+- tiles.png: a 16 x 8 sRGB image of coloured tiles with a gradient, for bitmap textures;
+- quad.obj: a unit square with texture coordinates (OBJ's v up), for textured meshes.
 """
 import math
 import os
 import random
 import struct
+import zlib
 
 WIDTH, HEIGHT = 256, 128
 SUN = (0.55, 0.62, 0.56)
@@ -125,9 +128,40 @@ def write_ball(path):
     write_obj(path, uv_sphere(BALL_COLUMNS, BALL_ROWS, lambda theta, phi: 1.0))
 
 
+def write_png(path, width, height, texel):
+    """An 8-bit RGB PNG whose texel (column, row) is texel(column, row), row 0 on top."""
+    def chunk(kind, data):
+        body = kind + data
+        return struct.pack(">I", len(data)) + body + struct.pack(">I", zlib.crc32(body) & 0xFFFFFFFF)
+
+    raw = b"".join(b"\x00" + bytes(c for x in range(width) for c in texel(x, y)) for y in range(height))
+    header = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    with open(path + ".tmp", "wb") as f:
+        f.write(b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(raw))
+                + chunk(b"IEND", b""))
+    os.replace(path + ".tmp", path)
+
+
+def tile(x, y):
+    """Coloured tiles of 4 x 4 texels with a gradient across the image."""
+    colours = [(220, 60, 40), (40, 160, 90), (50, 80, 200), (230, 200, 60)]
+    r, g, b = colours[(x // 4 + 2 * (y // 4)) % 4]
+    shade = 0.55 + 0.45 * x / 15
+    return (int(r * shade), int(g * shade), int(b * shade))
+
+
+def write_quad(path):
+    """The square [-1, 1]^2 at z = 0 with texture coordinates running over [0, 2] x [0, 1]."""
+    write_obj(path, ["v -1 -1 0", "v 1 -1 0", "v 1 1 0", "v -1 1 0",
+                     "vt 0 0", "vt 2 0", "vt 2 1", "vt 0 1",
+                     "f 1/1 2/2 3/3", "f 1/1 3/3 4/4"])
+
+
 def main():
     folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "assets")
     os.makedirs(folder, exist_ok=True)
+    write_png(os.path.join(folder, "tiles.png"), 16, 8, tile)
+    write_quad(os.path.join(folder, "quad.obj"))
     write_blob(os.path.join(folder, "blob.obj"))
     write_leaves(os.path.join(folder, "leaves.obj"))
     write_ball(os.path.join(folder, "ball.obj"))

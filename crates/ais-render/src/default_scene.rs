@@ -72,6 +72,7 @@ pub fn sculpture() -> TriangleMesh {
     TriangleMesh {
         positions,
         normals: Some(normals),
+        texcoords: None,
         triangles,
     }
 }
@@ -211,6 +212,7 @@ pub fn default_world(width: u32, height: u32) -> World {
         sample_count: 4,
         shapes: Vec::new(),
         bsdfs: Vec::new(),
+        textures: Vec::new(),
         emitters: Vec::new(),
         integrator: None,
         warnings: Vec::new(),
@@ -219,6 +221,7 @@ pub fn default_world(width: u32, height: u32) -> World {
     World {
         geometry,
         lights,
+        albedo_textures: vec![None; materials.len()],
         materials,
         camera: Camera::new(&camera_description, width, height),
         resolution: (width, height),

@@ -153,6 +153,39 @@ fn read_hdr(path: &Path) -> Result<RgbImage, InputError> {
     })
 }
 
+/// Reads a PNG or JPEG texture into linear RGB: sRGB-decoded when `srgb` (Mitsuba's
+/// default for such images), else the stored values scaled to [0, 1]. At most 16384 texels
+/// a side; alpha is dropped.
+pub fn read_ldr_image(path: &Path, srgb: bool) -> Result<RgbImage, InputError> {
+    crate::error::check_input_file(path, "image file")?;
+    let mut reader = image::ImageReader::open(path)
+        .and_then(|r| r.with_guessed_format())
+        .map_err(|e| InputError::new(path, format!("cannot open image: {e}")))?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(16384);
+    limits.max_image_height = Some(16384);
+    reader.limits(limits);
+    let decoded = reader
+        .decode()
+        .map_err(|e| InputError::new(path, format!("cannot read image: {e}")))?
+        .into_rgb32f();
+    let decode = |c: f32| if srgb { srgb_to_linear(c) } else { c };
+    Ok(RgbImage {
+        width: decoded.width() as usize,
+        height: decoded.height() as usize,
+        pixels: decoded.pixels().map(|p| p.0.map(decode)).collect(),
+    })
+}
+
+/// The sRGB transfer function, inverted: an encoded value in [0, 1] to linear.
+pub fn srgb_to_linear(c: f32) -> f32 {
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// An error while writing an output image.
 #[derive(Debug)]
 pub struct WriteError(pub String);

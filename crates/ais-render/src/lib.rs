@@ -23,6 +23,7 @@ pub mod render;
 pub mod request;
 pub mod scene;
 pub mod shapes;
+pub mod texture;
 pub mod world;
 
 pub use error::InputError;

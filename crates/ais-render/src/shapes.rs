@@ -4,46 +4,57 @@
 use crate::error::InputError;
 use crate::geometry::{ShapeGeometry, Sphere};
 use crate::mesh::TriangleMesh;
-use glam::{DMat4, DVec3, Vec3};
+use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::path::Path;
 
 /// Segments of the triangle fan that stands for a disk (area error below 0.04%).
 pub const DISK_SEGMENTS: u32 = 256;
 
-/// The square [-1, 1]² at z = 0, normal +z.
+/// The square [-1, 1]² at z = 0, normal +z, with Mitsuba's texture coordinates
+/// ((x + 1) / 2, (y + 1) / 2).
 pub fn rectangle() -> TriangleMesh {
+    let corners = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)];
     TriangleMesh {
-        positions: vec![
-            Vec3::new(-1.0, -1.0, 0.0),
-            Vec3::new(1.0, -1.0, 0.0),
-            Vec3::new(1.0, 1.0, 0.0),
-            Vec3::new(-1.0, 1.0, 0.0),
-        ],
+        positions: corners.map(|(x, y)| Vec3::new(x, y, 0.0)).to_vec(),
         normals: None,
+        texcoords: Some(
+            corners
+                .map(|(x, y)| Vec2::new((x + 1.0) / 2.0, (y + 1.0) / 2.0))
+                .to_vec(),
+        ),
         triangles: vec![[0, 1, 2], [0, 2, 3]],
     }
 }
 
-/// The unit disk at z = 0, normal +z, as a fan of [`DISK_SEGMENTS`] triangles.
+/// The unit disk at z = 0, normal +z, as a fan of [`DISK_SEGMENTS`] triangles, with
+/// Mitsuba's texture coordinates (radius, angle / 2π). Each triangle has its own vertices, so
+/// that the angle does not wrap inside a triangle and the centre takes its triangle's angle.
 pub fn disk() -> TriangleMesh {
-    let mut positions = vec![Vec3::ZERO];
-    positions.extend((0..DISK_SEGMENTS).map(|i| {
+    let mut mesh = TriangleMesh::default();
+    let rim = |i: u32| {
         let phi = std::f32::consts::TAU * i as f32 / DISK_SEGMENTS as f32;
         Vec3::new(phi.cos(), phi.sin(), 0.0)
-    }));
-    let triangles = (0..DISK_SEGMENTS)
-        .map(|i| [0, 1 + i, 1 + (i + 1) % DISK_SEGMENTS])
-        .collect();
-    TriangleMesh {
-        positions,
-        normals: None,
-        triangles,
+    };
+    let segments = DISK_SEGMENTS as f32;
+    let mut texcoords = Vec::new();
+    for i in 0..DISK_SEGMENTS {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend([Vec3::ZERO, rim(i), rim(i + 1)]);
+        texcoords.extend([
+            Vec2::new(0.0, (i as f32 + 0.5) / segments),
+            Vec2::new(1.0, i as f32 / segments),
+            Vec2::new(1.0, (i + 1) as f32 / segments),
+        ]);
+        mesh.triangles.push([base, base + 1, base + 2]);
     }
+    mesh.texcoords = Some(texcoords);
+    mesh
 }
 
 /// The cube [-1, 1]³ with outward faces.
 pub fn cube() -> TriangleMesh {
     let mut mesh = TriangleMesh::default();
+    let mut texcoords = Vec::new();
     for axis in 0..3 {
         for sign in [-1.0f32, 1.0] {
             let normal =
@@ -58,13 +69,31 @@ pub fn cube() -> TriangleMesh {
             let v = normal.cross(u);
             let base = mesh.positions.len() as u32;
             for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                mesh.positions.push(normal + a * u + b * v);
+                let position = normal + a * u + b * v;
+                mesh.positions.push(position);
+                texcoords.push(cube_texcoords(axis, sign, position));
             }
             mesh.triangles.push([base, base + 1, base + 2]);
             mesh.triangles.push([base, base + 2, base + 3]);
         }
     }
+    mesh.texcoords = Some(texcoords);
     mesh
+}
+
+/// Mitsuba's texture coordinates on the cube's face `sign` · `axis` (each face maps [0, 1]²
+/// affinely; read from Mitsuba's own cube).
+fn cube_texcoords(axis: usize, sign: f32, p: Vec3) -> Vec2 {
+    let up = |c: f32| (c + 1.0) / 2.0;
+    let down = |c: f32| (1.0 - c) / 2.0;
+    match (axis, sign > 0.0) {
+        (0, true) => Vec2::new(up(p.y), down(p.z)),
+        (0, false) => Vec2::new(up(p.y), up(p.z)),
+        (1, true) => Vec2::new(down(p.x), down(p.z)),
+        (1, false) => Vec2::new(up(p.z), up(p.x)),
+        (_, true) => Vec2::new(up(p.y), up(p.x)),
+        (_, false) => Vec2::new(down(p.y), up(p.x)),
+    }
 }
 
 /// A sphere under `to_world`, which must scale uniformly.

@@ -1,6 +1,6 @@
 //! A scene ready to render: geometry in a BVH, the camera, and the settings.
 
-use crate::bsdf::Material;
+use crate::bsdf::{albedo_texture, Material, TextureScene};
 use crate::camera::Camera;
 use crate::error::InputError;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
@@ -9,7 +9,10 @@ use crate::lights::{AreaLight, AreaShape, Emitters, Lights, Rectangle};
 use crate::mesh::{load_mesh, validate, TriangleMesh};
 use crate::scene::{self, SceneDescription};
 use crate::shapes;
+use crate::texture::Texture;
 use glam::Vec3;
+use std::collections::HashMap;
+use std::sync::Arc;
 
 /// Everything a render needs.
 pub struct World {
@@ -25,6 +28,8 @@ pub struct World {
     pub lights: Lights,
     /// The material of each shape.
     pub materials: Vec<Material>,
+    /// For each shape, the texture that gives its material's albedo at a hit, if any.
+    pub albedo_textures: Vec<Option<Arc<Texture>>>,
     /// The description it was built from.
     pub description: SceneDescription,
     /// Warnings from reading the scene and its assets.
@@ -54,6 +59,64 @@ fn shape_material(
         None if shape.emitter.is_some() => Material::diffuse(Vec3::ZERO),
         None => Material::default(),
     })
+}
+
+/// The albedo textures of a scene's shapes, each BSDF's read once (and its image loaded
+/// once) however many shapes use it.
+#[derive(Default)]
+struct ShapeTextures {
+    per_shape: Vec<Option<Arc<Texture>>>,
+    by_bsdf: HashMap<usize, Option<Arc<Texture>>>,
+}
+
+impl ShapeTextures {
+    /// Adds the texture of `shape`'s BSDF, if it has one.
+    fn add(
+        &mut self,
+        description: &SceneDescription,
+        shape: &scene::ShapeDescription,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), InputError> {
+        let texture = match shape.bsdf {
+            Some(index) if !self.by_bsdf.contains_key(&index) => {
+                let scene = TextureScene {
+                    file: &description.file,
+                    files: &description.files,
+                    bsdfs: &description.bsdfs,
+                    textures: &description.textures,
+                };
+                let texture = albedo_texture(&description.bsdfs[index], &scene, warnings)?;
+                let texture = texture.map(Arc::new);
+                self.by_bsdf.insert(index, texture.clone());
+                texture
+            }
+            Some(index) => self.by_bsdf[&index].clone(),
+            None => None,
+        };
+        if texture.is_some() && rotated_sphere(shape) {
+            warnings.push(format!(
+                "{}:{}: a textured sphere's texture coordinates ignore the rotation in its \
+                 to_world (they follow the world's axes)",
+                description.file.display(),
+                shape.line
+            ));
+        }
+        self.per_shape.push(texture);
+        Ok(())
+    }
+}
+
+/// Whether `shape` is a sphere whose `to_world` rotates it.
+fn rotated_sphere(shape: &scene::ShapeDescription) -> bool {
+    if !matches!(shape.geometry, scene::ShapeGeometry::Sphere { .. }) {
+        return false;
+    }
+    let rotation = glam::DMat3::from_mat4(shape.to_world);
+    let scale = rotation.x_axis.length();
+    (rotation - glam::DMat3::from_diagonal(glam::DVec3::splat(scale)))
+        .to_cols_array()
+        .iter()
+        .any(|x| x.abs() > 1e-9 * scale.max(1.0))
 }
 
 /// An analytic sphere (centre, radius) under the shape's `to_world`, with its area light.
@@ -152,8 +215,10 @@ impl World {
         let mut inputs = Vec::with_capacity(description.shapes.len());
         let mut area_lights = Vec::new();
         let mut materials = Vec::with_capacity(description.shapes.len());
+        let mut textures = ShapeTextures::default();
         for (index, shape) in description.shapes.iter().enumerate() {
             materials.push(shape_material(&description, shape, &mut warnings)?);
+            textures.add(&description, shape, &mut warnings)?;
             let built = build_shape(&file, shape, index as u32, &mut warnings)?;
             inputs.push(built.input);
             area_lights.extend(built.light);
@@ -186,6 +251,7 @@ impl World {
             geometry,
             lights,
             materials,
+            albedo_textures: textures.per_shape,
             camera: Camera::new(&description.camera, width, height),
             resolution: description.resolution,
             sample_count: description.sample_count,

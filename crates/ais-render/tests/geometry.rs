@@ -172,6 +172,7 @@ fn offset_rays_do_not_hit_the_surface_they_leave() {
             Vec3::new(505.0, 530.0, 470.0),
         ],
         normals: None,
+        texcoords: None,
         triangles: vec![[0, 1, 2]],
     };
     let geometry = Geometry::build(vec![

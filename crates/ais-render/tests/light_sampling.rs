@@ -170,7 +170,7 @@ fn environment_guided_by_an_affinity_map_fits() {
         receiver: Receiver::guided(Vec3::ZERO, &guide),
         frame: ShadingFrame::new(&material, normal, normal, wo),
         wo,
-        material: &material,
+        material: std::borrow::Cow::Borrowed(&material),
         lights: &lights,
     };
     for (seed, strategy) in [(22, Strategy::Light), (23, Strategy::Mis)] {
@@ -350,7 +350,7 @@ fn every_gather_proposal_fits() {
         receiver: Receiver::new(Vec3::ZERO),
         frame,
         wo,
-        material: &material,
+        material: std::borrow::Cow::Borrowed(&material),
         lights: &lights,
     };
     for (seed, strategy) in [

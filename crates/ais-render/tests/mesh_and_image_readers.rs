@@ -251,3 +251,36 @@ fn malformed_files_are_named_for_what_is_wrong() {
     assert_eq!(loaded.image.pixels[0], [0.0, 1.0, 1.0]);
     assert!(loaded.warning.unwrap().contains("above 1e20"));
 }
+
+#[test]
+fn texture_coordinates_follow_mitsubas_readers() {
+    // OBJ's v runs up the image and Mitsuba flips it on import; PLY's u, v (or s, t) are
+    // taken as they are (both read from Mitsuba 3.9.1's own loaders on these files).
+    let obj = scratch("uv.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.1 0.2\nvt 0.3 0.4\nvt 0.5 0.6\nf 1/1 2/2 3/3\n",
+    )
+    .unwrap();
+    let texcoords = load_mesh(&obj, MeshFormat::Obj).unwrap().mesh.texcoords;
+    let expected = [(0.1, 0.8), (0.3, 0.6), (0.5, 0.4)].map(|(u, v)| glam::Vec2::new(u, v));
+    let texcoords = texcoords.expect("the OBJ has texture coordinates");
+    for (got, want) in texcoords.iter().zip(expected) {
+        assert!((*got - want).length() < 1e-6, "{got} vs {want}");
+    }
+    let ply = scratch("uv.ply");
+    let header = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+                  property float z\nproperty float s\nproperty float t\nelement face 1\n\
+                  property list uchar int vertex_indices\nend_header\n";
+    std::fs::write(
+        &ply,
+        format!("{header}0 0 0 0.1 0.2\n1 0 0 0.3 0.4\n0 1 0 0.5 0.6\n3 0 1 2\n"),
+    )
+    .unwrap();
+    let texcoords = load_mesh(&ply, MeshFormat::Ply)
+        .unwrap()
+        .mesh
+        .texcoords
+        .unwrap();
+    assert!((texcoords[2] - glam::Vec2::new(0.5, 0.6)).length() < 1e-6);
+}

@@ -305,3 +305,80 @@ fn any_mitsuba_integrator_renders_as_the_gather_with_a_warning() {
         }
     }
 }
+
+#[test]
+fn texture_errors_name_file_line_and_problem() {
+    let shape = |bsdf: &str| {
+        format!("<scene>{bsdf}<shape type=\"rectangle\"><ref id=\"b\"/></shape></scene>")
+    };
+    let cases: Vec<(String, &str)> = vec![
+        (
+            shape("<bsdf type=\"diffuse\" id=\"b\">\n<texture type=\"noise\" name=\"reflectance\"/></bsdf>"),
+            "test.xml:2: texture type \"noise\" is not supported (checkerboard, bitmap)",
+        ),
+        (
+            shape("<bsdf type=\"diffuse\" id=\"b\">\n<texture type=\"bitmap\" name=\"reflectance\"/></bsdf>"),
+            "test.xml:2: bitmap needs a \"filename\"",
+        ),
+        (
+            shape("<bsdf type=\"diffuse\" id=\"b\">\n<texture type=\"bitmap\" name=\"reflectance\"><string name=\"filename\" value=\"t.png\"/><string name=\"wrap_mode\" value=\"spiral\"/></texture></bsdf>"),
+            "test.xml:2: unknown wrap_mode \"spiral\"",
+        ),
+        (
+            shape("<bsdf type=\"diffuse\" id=\"b\">\n<ref name=\"reflectance\" id=\"missing\"/></bsdf>"),
+            "test.xml:2: no <texture> with id \"missing\"",
+        ),
+        (
+            shape("<bsdf type=\"diffuse\" id=\"b\"><texture type=\"checkerboard\" name=\"reflectance\">\n<texture type=\"checkerboard\" name=\"color0\"/></texture></bsdf>"),
+            "test.xml:2: a texture inside a texture (\"color0\") is not supported",
+        ),
+        (
+            shape("<bsdf type=\"diffuse\" id=\"b\"><texture type=\"bitmap\" name=\"reflectance\">\n<string name=\"filename\" value=\"nowhere.png\"/></texture></bsdf>"),
+            "nowhere.png",
+        ),
+    ];
+    for (text, expected) in &cases {
+        let description = parse(text).expect("the file itself is well formed");
+        let Err(e) = ais_render::world::World::from_description(description) else {
+            panic!("{text} should be refused");
+        };
+        let message = e.to_string();
+        assert!(
+            message.contains(expected),
+            "for {text}\n got: {message}\n want: {expected}"
+        );
+    }
+}
+
+#[test]
+fn textures_reach_the_albedo_and_warn_where_they_do_not() {
+    let text = r#"<scene>
+        <texture type="checkerboard" id="checks"><rgb name="color0" value="0.9"/></texture>
+        <bsdf type="diffuse" id="d"><ref name="reflectance" id="checks"/></bsdf>
+        <bsdf type="roughconductor" id="c">
+            <texture type="checkerboard" name="specular_reflectance"/></bsdf>
+        <shape type="rectangle"><ref id="d"/></shape>
+        <shape type="rectangle"><ref id="c"/></shape>
+        <shape type="sphere"><transform name="to_world"><rotate x="1" angle="30"/></transform><ref id="d"/></shape>
+    </scene>"#;
+    let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
+    let board = world.albedo_textures[0]
+        .as_ref()
+        .expect("the diffuse is textured");
+    assert_eq!(
+        board.eval(glam::Vec2::new(0.1, 0.1)),
+        glam::Vec3::splat(0.9)
+    );
+    assert!(world.albedo_textures[1].is_none());
+    let warned = |want: &str| world.warnings.iter().any(|w| w.contains(want));
+    assert!(
+        warned("textures are not supported: specular_reflectance"),
+        "{:?}",
+        world.warnings
+    );
+    assert!(
+        warned("ignore the rotation in its to_world"),
+        "{:?}",
+        world.warnings
+    );
+}

@@ -1,11 +1,13 @@
 //! BSDFs: Mitsuba's `diffuse`, `roughconductor` and `roughplastic` (GGX, visible-normal
 //! sampling) and the `twosided` adapter, each evaluating as Mitsuba 3 does.
 
+mod albedo;
 mod conductors;
 mod microfacet;
 mod reader;
 mod rough_plastic;
 
+pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
 pub use rough_plastic::RoughPlastic;

@@ -180,7 +180,12 @@ impl BsdfReader<'_> {
             let known = known_properties(&plugin.kind);
             crate::scene::warn_unknown(self.file, plugin, known, self.warnings);
         }
-        for child in plugin.children.iter().filter(|c| c.tag == "texture") {
+        let albedo = super::albedo::albedo_parameter(&plugin.kind);
+        for child in plugin
+            .children
+            .iter()
+            .filter(|c| c.tag == "texture" && c.name.as_deref() != albedo)
+        {
             self.warnings.push(format!(
                 "{}:{}: textures are not supported: {} \"{}\" keeps its default",
                 self.file.display(),

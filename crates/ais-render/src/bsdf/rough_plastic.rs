@@ -45,6 +45,17 @@ pub struct RoughPlastic {
     specular_weight: f32,
 }
 
+/// The share of samples the specular lobe gets: its mean reflectance over both lobes'.
+fn specular_weight(diffuse: Vec3, specular: Vec3) -> f32 {
+    let d_mean = (diffuse.x + diffuse.y + diffuse.z) / 3.0;
+    let s_mean = (specular.x + specular.y + specular.z) / 3.0;
+    if d_mean + s_mean > 0.0 {
+        s_mean / (d_mean + s_mean)
+    } else {
+        0.5
+    }
+}
+
 #[derive(Debug, PartialEq)]
 struct Interface {
     transmittance: [f32; TABLE_SIZE],
@@ -61,8 +72,6 @@ impl RoughPlastic {
         specular: Vec3,
         nonlinear: bool,
     ) -> Self {
-        let d_mean = (diffuse.x + diffuse.y + diffuse.z) / 3.0;
-        let s_mean = (specular.x + specular.y + specular.z) / 3.0;
         RoughPlastic {
             interface: Interface::cached(microfacet, eta),
             microfacet,
@@ -70,11 +79,16 @@ impl RoughPlastic {
             diffuse,
             specular,
             nonlinear,
-            specular_weight: if d_mean + s_mean > 0.0 {
-                s_mean / (d_mean + s_mean)
-            } else {
-                0.5
-            },
+            specular_weight: specular_weight(diffuse, specular),
+        }
+    }
+
+    /// The same plastic with base albedo `diffuse` (the interface terms are shared).
+    pub fn with_diffuse(&self, diffuse: Vec3) -> Self {
+        RoughPlastic {
+            diffuse,
+            specular_weight: specular_weight(diffuse, self.specular),
+            ..self.clone()
         }
     }
 

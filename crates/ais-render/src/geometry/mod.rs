@@ -46,12 +46,15 @@ pub struct Hit {
     pub shading_normal: Vec3,
     /// Index of the shape (in the order given to [`Geometry::build`]).
     pub shape: u32,
+    /// Texture coordinates (Mitsuba's conventions; zero on a mesh without them).
+    pub uv: Vec2,
 }
 
 /// Per-mesh data needed to shade a triangle hit.
 #[derive(Clone, Debug)]
 struct MeshShading {
     normals: Option<Vec<Vec3>>,
+    texcoords: Option<Vec<Vec2>>,
     triangles: Vec<[u32; 3]>,
 }
 
@@ -140,6 +143,7 @@ impl Geometry {
                 self.triangle_count += mesh.triangles.len();
                 self.meshes.push(MeshShading {
                     normals: mesh.normals,
+                    texcoords: mesh.texcoords,
                     triangles: mesh.triangles,
                 });
             }
@@ -240,16 +244,18 @@ impl Geometry {
         } else {
             1.0
         };
-        let (geometric_normal, shading_normal) = match &self.packed[index] {
+        let (geometric_normal, shading_normal, uv) = match &self.packed[index] {
             Packed::Sphere(s) => {
-                let n = (point - s.center).normalize() * flip;
-                (n, n)
+                let outward = (point - s.center).normalize();
+                (outward * flip, outward * flip, sphere_texcoords(outward))
             }
             triangle => {
                 let n = triangle.triangle_normal().unwrap_or(Vec3::Y).normalize() * flip;
+                let shading = self.interpolated_normal(source, barycentrics).unwrap_or(n);
                 (
                     n,
-                    self.interpolated_normal(source, barycentrics).unwrap_or(n),
+                    shading,
+                    self.interpolated_texcoords(source, barycentrics),
                 )
             }
         };
@@ -259,7 +265,21 @@ impl Geometry {
             geometric_normal,
             shading_normal,
             shape: source.shape,
+            uv,
         }
+    }
+
+    /// The texture coordinates of a triangle's mesh interpolated at `barycentrics` (zero
+    /// when the mesh has none).
+    fn interpolated_texcoords(&self, source: PrimitiveSource, barycentrics: Vec2) -> Vec2 {
+        let mesh = &self.meshes[source.mesh as usize];
+        let Some(texcoords) = mesh.texcoords.as_ref() else {
+            return Vec2::ZERO;
+        };
+        let [a, b, c] = mesh.triangles[source.index as usize];
+        texcoords[a as usize] * (1.0 - barycentrics.x - barycentrics.y)
+            + texcoords[b as usize] * barycentrics.x
+            + texcoords[c as usize] * barycentrics.y
     }
 
     /// The vertex normals of a triangle's mesh interpolated at `barycentrics` (None: the mesh
@@ -275,6 +295,17 @@ impl Geometry {
         let s = interpolated.normalize_or_zero();
         (s != Vec3::ZERO).then_some(s)
     }
+}
+
+/// Mitsuba's texture coordinates on a sphere at the unit `outward` direction from its
+/// centre: (azimuth about z / 2π, polar angle from +z / π). A sphere here keeps no rotation,
+/// so these are in world axes.
+fn sphere_texcoords(outward: Vec3) -> Vec2 {
+    let mut u = outward.y.atan2(outward.x) / std::f32::consts::TAU;
+    if u < 0.0 {
+        u += 1.0;
+    }
+    Vec2::new(u, outward.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI)
 }
 
 /// Centre and radius of a sphere enclosing every primitive (zero for none).

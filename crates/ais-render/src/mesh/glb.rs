@@ -33,6 +33,9 @@ struct Assembly<'a> {
     mesh: TriangleMesh,
     normals: Vec<Vec3>,
     all_have_normals: bool,
+    /// glTF's texture coordinates already run down the image, as Mitsuba's do.
+    texcoords: Vec<glam::Vec2>,
+    all_have_texcoords: bool,
 }
 
 impl Assembly<'_> {
@@ -73,6 +76,12 @@ impl Assembly<'_> {
                     .normalize_or_zero()
             })),
             _ => self.all_have_normals = false,
+        }
+        match reader.read_tex_coords(0) {
+            Some(t) if self.all_have_texcoords => {
+                self.texcoords.extend(t.into_f32().map(glam::Vec2::from))
+            }
+            _ => self.all_have_texcoords = false,
         }
         let count = positions.len() as u32;
         self.mesh.positions.extend(positions);
@@ -118,6 +127,8 @@ fn read_unguarded(path: &Path) -> Result<TriangleMesh, InputError> {
         mesh: TriangleMesh::default(),
         normals: Vec::new(),
         all_have_normals: true,
+        texcoords: Vec::new(),
+        all_have_texcoords: true,
     };
     let scene = gltf
         .default_scene()
@@ -137,10 +148,15 @@ fn read_unguarded(path: &Path) -> Result<TriangleMesh, InputError> {
         mut mesh,
         normals,
         all_have_normals,
+        texcoords,
+        all_have_texcoords,
         ..
     } = assembly;
     if all_have_normals && normals.len() == mesh.positions.len() && !normals.is_empty() {
         mesh.normals = Some(normals);
+    }
+    if all_have_texcoords && texcoords.len() == mesh.positions.len() && !texcoords.is_empty() {
+        mesh.texcoords = Some(texcoords);
     }
     Ok(mesh)
 }

@@ -16,6 +16,8 @@ pub struct TriangleMesh {
     pub positions: Vec<Vec3>,
     /// Per-vertex normals (same length as `positions`), if the file had them.
     pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates (same length as `positions`), if the file had them.
+    pub texcoords: Option<Vec<glam::Vec2>>,
     /// Triangles as vertex indices.
     pub triangles: Vec<[u32; 3]>,
 }
@@ -88,6 +90,15 @@ pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, Input
                 path.display()
             ));
             mesh.normals = None;
+        }
+    }
+    if let Some(texcoords) = &mesh.texcoords {
+        if texcoords.len() != mesh.positions.len() || texcoords.iter().any(|t| !t.is_finite()) {
+            warnings.push(format!(
+                "{}: texture coordinates are incomplete or not finite; the mesh has none",
+                path.display()
+            ));
+            mesh.texcoords = None;
         }
     }
     let before = mesh.triangles.len();

@@ -2,7 +2,7 @@
 
 use super::TriangleMesh;
 use crate::error::InputError;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::path::Path;
 
 /// Refuses faces of fewer than three vertices, naming their line (tobj would turn them into
@@ -44,6 +44,8 @@ pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
     let mut mesh = TriangleMesh::default();
     let mut all_have_normals = true;
     let mut normals = Vec::new();
+    let mut all_have_texcoords = true;
+    let mut texcoords = Vec::new();
     for model in &models {
         let m = &model.mesh;
         let base = mesh.positions.len() as u32;
@@ -61,6 +63,16 @@ pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
         } else {
             all_have_normals = false;
         }
+        if m.texcoords.len() / 2 == m.positions.len() / 3 && !m.texcoords.is_empty() {
+            // Mitsuba flips v on import (OBJ's v runs up the image, Mitsuba's down).
+            texcoords.extend(
+                m.texcoords
+                    .chunks_exact(2)
+                    .map(|t| Vec2::new(t[0], 1.0 - t[1])),
+            );
+        } else {
+            all_have_texcoords = false;
+        }
         mesh.triangles.extend(
             m.indices
                 .chunks_exact(3)
@@ -69,6 +81,9 @@ pub fn read(path: &Path) -> Result<TriangleMesh, InputError> {
     }
     if all_have_normals && !normals.is_empty() {
         mesh.normals = Some(normals);
+    }
+    if all_have_texcoords && !texcoords.is_empty() {
+        mesh.texcoords = Some(texcoords);
     }
     Ok(mesh)
 }

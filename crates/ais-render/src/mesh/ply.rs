@@ -2,7 +2,7 @@
 
 use super::TriangleMesh;
 use crate::error::InputError;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use ply_rs_bw::parser::Parser;
 use ply_rs_bw::ply::{DefaultElement, Property};
 use std::path::Path;
@@ -11,13 +11,27 @@ fn scalar(element: &DefaultElement, name: &str) -> Option<f32> {
     element.get(name).and_then(Property::to_f32_lossy)
 }
 
-/// The `vertex` element's positions, and its normals if every vertex has them.
+/// A vertex's texture coordinates, under any of the names PLY writers use.
+fn texcoord(vertex: &DefaultElement) -> Option<Vec2> {
+    [
+        ("u", "v"),
+        ("s", "t"),
+        ("texture_u", "texture_v"),
+        ("texture_s", "texture_t"),
+    ]
+    .iter()
+    .find_map(|(u, v)| Some(Vec2::new(scalar(vertex, u)?, scalar(vertex, v)?)))
+}
+
+/// The `vertex` element's positions, and its normals and texture coordinates if every
+/// vertex has them.
 fn read_vertices(
     path: &Path,
     vertices: &[DefaultElement],
     mesh: &mut TriangleMesh,
 ) -> Result<(), InputError> {
     let mut normals = Vec::with_capacity(vertices.len());
+    let mut texcoords = Vec::with_capacity(vertices.len());
     for (index, vertex) in vertices.iter().enumerate() {
         let coordinate = |name| {
             scalar(vertex, name).ok_or_else(|| {
@@ -39,9 +53,13 @@ fn read_vertices(
         ) {
             normals.push(Vec3::new(x, y, z));
         }
+        texcoords.extend(texcoord(vertex));
     }
     if normals.len() == mesh.positions.len() && !normals.is_empty() {
         mesh.normals = Some(normals);
+    }
+    if texcoords.len() == mesh.positions.len() && !texcoords.is_empty() {
+        mesh.texcoords = Some(texcoords);
     }
     Ok(())
 }

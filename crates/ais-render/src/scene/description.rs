@@ -126,6 +126,8 @@ pub struct SceneDescription {
     pub shapes: Vec<ShapeDescription>,
     /// BSDFs (top-level with ids, and those nested in shapes), carried for the shading code.
     pub bsdfs: Vec<Plugin>,
+    /// Top-level textures, which BSDFs reference by id.
+    pub textures: Vec<Plugin>,
     /// Scene-level emitters (`envmap`, `constant`, …), carried for the lighting code.
     pub emitters: Vec<Plugin>,
     /// Where its relative file names point (`<path>` elements, then its folder).
@@ -168,6 +170,7 @@ pub fn parse_scene(
         sample_count: 4,
         shapes: Vec::new(),
         bsdfs: Vec::new(),
+        textures: Vec::new(),
         emitters: Vec::new(),
         integrator: None,
         warnings: parsed.warnings,
@@ -185,6 +188,12 @@ pub fn parse_scene(
         }
         scene.bsdfs.push(plugin.clone());
     }
+    scene.textures = parsed
+        .plugins
+        .iter()
+        .filter(|p| p.tag == "texture")
+        .cloned()
+        .collect();
     let mut sensor_seen = false;
     for plugin in &parsed.plugins {
         if plugin.tag == "sensor" {

@@ -60,7 +60,14 @@ pub fn npm_package(test: &str, spec: &str) -> Option<PathBuf> {
 /// `scenes/make_assets.py`) if they are missing; `Err` says why they could not be.
 pub fn shipped_scenes() -> Result<PathBuf, String> {
     let folder = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../scenes");
-    let assets = ["sky.hdr", "blob.obj", "leaves.obj", "ball.obj"];
+    let assets = [
+        "sky.hdr",
+        "blob.obj",
+        "leaves.obj",
+        "ball.obj",
+        "tiles.png",
+        "quad.obj",
+    ];
     if assets
         .iter()
         .any(|name| !folder.join("assets").join(name).exists())

@@ -7,6 +7,7 @@ use crate::lights::{Lights, Receiver, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
+use std::borrow::Cow;
 use std::f64::consts::PI;
 
 /// Which distribution proposes the gather's candidate directions.
@@ -58,18 +59,23 @@ pub struct GatherPoint<'a> {
     pub frame: ShadingFrame,
     /// Direction toward the viewer.
     pub wo: Vec3,
-    /// Its material.
-    pub material: &'a Material,
+    /// Its material (with its texture's albedo at the hit, if it has one).
+    pub material: Cow<'a, Material>,
     /// The scene's emitters.
     pub lights: &'a Lights,
 }
 
 /// The gather point where `hit` is seen from direction `wo` (pointing away from it).
 pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a> {
-    let material = &world.materials[hit.shape as usize];
+    let material = match &world.albedo_textures[hit.shape as usize] {
+        Some(texture) => {
+            Cow::Owned(world.materials[hit.shape as usize].with_albedo(texture.eval(hit.uv)))
+        }
+        None => Cow::Borrowed(&world.materials[hit.shape as usize]),
+    };
     GatherPoint {
         receiver: Receiver::new(hit.point),
-        frame: ShadingFrame::new(material, hit.shading_normal, hit.geometric_normal, wo),
+        frame: ShadingFrame::new(&material, hit.shading_normal, hit.geometric_normal, wo),
         wo,
         material,
         lights: &world.lights,
