@@ -11,7 +11,10 @@ a flat (uncompressed) Radiance RGBE image. It also writes, into the same folder:
   a slab 4 x 0.8 x 4 m, a canopy that occludes partly at every scale;
 - ball.obj: a smooth sphere of radius 1 with 7,920 triangles, an emitting mesh;
 - tiles.png: a 16 x 8 sRGB image of coloured tiles with a gradient, for bitmap textures;
-- quad.obj: a unit square with texture coordinates (OBJ's v up), for textured meshes.
+- quad.obj: a unit square with texture coordinates (OBJ's v up), for textured meshes;
+- shapes.serialized: Mitsuba's serialized format (version 4) with two shapes: a square with
+  texture coordinates in single precision, and a pyramid with vertex normals in double
+  precision.
 """
 import math
 import os
@@ -157,9 +160,49 @@ def write_quad(path):
                      "f 1/1 2/2 3/3", "f 1/1 3/3 4/4"])
 
 
+def serialized_shape(name, positions, triangles, normals=None, texcoords=None, double=False):
+    """One shape of a serialized file: its header, then its zlib-compressed stream."""
+    real = "d" if double else "f"
+    flags = (0x2000 if double else 0x1000) | (0x0001 if normals else 0) | (0x0002 if texcoords else 0)
+    body = struct.pack("<I", flags) + name.encode() + b"\0" + struct.pack("<QQ", len(positions), len(triangles))
+    for block, width in ((positions, 3), (normals, 3), (texcoords, 2)):
+        if block:
+            body += b"".join(struct.pack("<" + real * width, *item) for item in block)
+    body += b"".join(struct.pack("<3I", *t) for t in triangles)
+    return struct.pack("<HH", 0x041C, 4) + zlib.compress(body)
+
+
+def write_serialized(path):
+    """A square with texture coordinates and a pyramid with normals, in one file."""
+    square = serialized_shape("square", [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)],
+                              [(0, 1, 2), (0, 2, 3)], texcoords=[(0, 0), (3, 0), (3, 3), (0, 3)])
+    apex, base = (0, 0, 1), [(-1, -1, 0), (1, -1, 0), (1, 1, 0), (-1, 1, 0)]
+    positions, triangles, normals = [], [], []
+    for i in range(4):
+        a, b = base[i], base[(i + 1) % 4]
+        ux, uy, uz = b[0] - a[0], b[1] - a[1], b[2] - a[2]
+        vx, vy, vz = apex[0] - a[0], apex[1] - a[1], apex[2] - a[2]
+        n = (uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx)
+        length = math.sqrt(sum(c * c for c in n))
+        n = tuple(c / length for c in n)
+        triangles.append((len(positions), len(positions) + 1, len(positions) + 2))
+        positions += [a, b, apex]
+        normals += [n, n, n]
+    pyramid = serialized_shape("pyramid", positions, triangles, normals=normals, double=True)
+    data, offsets = b"", []
+    for shape in (square, pyramid):
+        offsets.append(len(data))
+        data += shape
+    data += b"".join(struct.pack("<Q", o) for o in offsets) + struct.pack("<I", len(offsets))
+    with open(path + ".tmp", "wb") as f:
+        f.write(data)
+    os.replace(path + ".tmp", path)
+
+
 def main():
     folder = os.path.join(os.path.dirname(os.path.abspath(__file__)), "assets")
     os.makedirs(folder, exist_ok=True)
+    write_serialized(os.path.join(folder, "shapes.serialized"))
     write_png(os.path.join(folder, "tiles.png"), 16, 8, tile)
     write_quad(os.path.join(folder, "quad.obj"))
     write_blob(os.path.join(folder, "blob.obj"))

@@ -168,9 +168,19 @@ fn build_shape(
         scene::ShapeGeometry::Rectangle => shapes::rectangle(),
         scene::ShapeGeometry::Disk => shapes::disk(),
         scene::ShapeGeometry::Cube => shapes::cube(),
-        scene::ShapeGeometry::Mesh { path, format } => {
-            let loaded = load_mesh(path, *format)?;
+        scene::ShapeGeometry::Mesh {
+            path,
+            format,
+            flip_tex_coords,
+        } => {
+            let mut loaded = load_mesh(path, *format)?;
             warnings.extend(loaded.warnings);
+            // The OBJ reader flips v, as Mitsuba does unless told not to.
+            if *format == scene::MeshFormat::Obj && !flip_tex_coords {
+                for t in loaded.mesh.texcoords.iter_mut().flatten() {
+                    t.y = 1.0 - t.y;
+                }
+            }
             loaded.mesh
         }
     };

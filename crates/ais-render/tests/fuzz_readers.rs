@@ -14,6 +14,7 @@
 //! fails, to become a regression case.
 
 mod common;
+mod serialized_files;
 
 use ais_render::image_io::{read_image, write_exr, RgbImage};
 use ais_render::mesh::load_mesh;
@@ -265,6 +266,31 @@ fn the_glb_reader_survives_mutated_files() {
     fuzz("glb", mutated(common::glb(false)), |bytes| {
         std::fs::write(&path, bytes).unwrap();
         let _ = load_mesh(&path, MeshFormat::Glb);
+    });
+}
+
+#[test]
+fn the_serialized_reader_survives_mutated_files() {
+    use serialized_files::{serialized, serialized_body};
+    let path = scratch("mesh.serialized");
+    let square = [
+        [0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 2.0, 0.0],
+        [0.0, 2.0, 0.0],
+    ];
+    let body = serialized_body(&square, &[[0, 1, 2], [0, 2, 3]], None, false, 4);
+    // Mutations of the decompressed stream reach the parser; of the file, the framing.
+    let files = prop_oneof![
+        mutated(body).prop_map(|body| serialized(&[body], 4)),
+        mutated(serialized(
+            &[serialized_body(&square, &[[0, 1, 2]], None, true, 3)],
+            3
+        )),
+    ];
+    fuzz("serialized", files, |bytes| {
+        std::fs::write(&path, bytes).unwrap();
+        let _ = load_mesh(&path, MeshFormat::Serialized { shape_index: 0 });
     });
 }
 

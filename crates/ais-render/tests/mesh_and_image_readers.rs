@@ -1,6 +1,7 @@
 //! Mesh and image readers on files the tests generate.
 
 mod common;
+mod serialized_files;
 
 use ais_render::image_io::{read_image, write_exr, RgbImage};
 use ais_render::mesh::load_mesh;
@@ -283,4 +284,73 @@ fn texture_coordinates_follow_mitsubas_readers() {
         .texcoords
         .unwrap();
     assert!((texcoords[2] - glam::Vec2::new(0.5, 0.6)).length() < 1e-6);
+}
+
+#[test]
+fn serialized_files_of_both_versions_and_precisions() {
+    use serialized_files::{serialized, serialized_body};
+    let square = [
+        [0.0, 0.0, 0.0],
+        [2.0, 0.0, 0.0],
+        [2.0, 2.0, 0.0],
+        [0.0, 2.0, 0.0],
+    ];
+    let triangles = [[0, 1, 2], [0, 2, 3]];
+    let uv = [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]];
+    for version in [3u16, 4] {
+        let first = serialized_body(&square[..3], &triangles[..1], None, false, version);
+        let second = serialized_body(&square, &triangles, Some(&uv), true, version);
+        let path = scratch(&format!("shapes_v{version}.serialized"));
+        std::fs::write(&path, serialized(&[first, second], version)).unwrap();
+        let one = load_mesh(&path, MeshFormat::Serialized { shape_index: 0 }).unwrap();
+        assert!((one.mesh.area() - 2.0).abs() < 1e-6, "version {version}");
+        let two = load_mesh(&path, MeshFormat::Serialized { shape_index: 1 }).unwrap();
+        assert!((two.mesh.area() - 4.0).abs() < 1e-6, "version {version}");
+        assert_eq!(two.mesh.texcoords.unwrap()[2], glam::Vec2::ONE);
+        let e = load_mesh(&path, MeshFormat::Serialized { shape_index: 2 }).unwrap_err();
+        assert!(
+            e.to_string()
+                .contains("shape_index 2 is out of range: the file has 2 shape(s)"),
+            "{e}"
+        );
+    }
+}
+
+#[test]
+fn corrupt_serialized_files_are_refused_with_the_reason() {
+    use serialized_files::{serialized, serialized_body};
+    let body = serialized_body(
+        &[[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        &[[0, 1, 2]],
+        None,
+        false,
+        4,
+    );
+    let good = serialized(&[body.clone()], 4);
+    let mut wrong_header = good.clone();
+    wrong_header[0] = 0;
+    let mut short_body = body.clone();
+    short_body.truncate(body.len() - 4);
+    let mut huge_count = body.clone();
+    huge_count[10..18].copy_from_slice(&u64::MAX.to_le_bytes());
+    let mut no_precision = body;
+    no_precision[1] = 0;
+    let cases = [
+        (wrong_header, "not a serialized mesh"),
+        (good[..6].to_vec(), "too short"),
+        (serialized(&[short_body], 4), "ends early or is corrupt"),
+        (serialized(&[huge_count], 4), "more than ais reads"),
+        (serialized(&[no_precision], 4), "no single precision"),
+        (
+            good[..good.len() - 1].to_vec(),
+            "shape table at the end of the file is corrupt",
+        ),
+    ];
+    let path = scratch("corrupt.serialized");
+    for (bytes, expected) in cases {
+        std::fs::write(&path, bytes).unwrap();
+        let e = load_mesh(&path, MeshFormat::Serialized { shape_index: 0 }).unwrap_err();
+        assert!(e.to_string().contains(expected), "want {expected}, got {e}");
+        assert!(e.to_string().contains("corrupt.serialized"), "{e}");
+    }
 }

@@ -3,6 +3,7 @@
 mod glb;
 mod obj;
 mod ply;
+mod serialized;
 
 use crate::error::InputError;
 use crate::scene::MeshFormat;
@@ -38,6 +39,7 @@ pub fn load_mesh(path: &Path, format: MeshFormat) -> Result<LoadedMesh, InputErr
         MeshFormat::Obj => obj::read(path)?,
         MeshFormat::Ply => ply::read(path)?,
         MeshFormat::Glb => glb::read(path)?,
+        MeshFormat::Serialized { shape_index } => serialized::read(path, shape_index)?,
     };
     validate(path, mesh)
 }

@@ -65,6 +65,11 @@ pub enum MeshFormat {
     Ply,
     /// Binary glTF (our extension to Mitsuba's format).
     Glb,
+    /// Mitsuba's serialized format: the shape at `shape_index` in the file.
+    Serialized {
+        /// Which shape of the file.
+        shape_index: u32,
+    },
 }
 
 /// The geometry of a shape.
@@ -89,6 +94,8 @@ pub enum ShapeGeometry {
         path: PathBuf,
         /// Its format.
         format: MeshFormat,
+        /// Whether to flip v (an OBJ's `flip_tex_coords`, true by default as in Mitsuba).
+        flip_tex_coords: bool,
     },
 }
 
@@ -459,6 +466,7 @@ fn shape_geometry(
         Ok(ShapeGeometry::Mesh {
             path: files.resolve(name),
             format,
+            flip_tex_coords: shape.boolean("flip_tex_coords", true)?,
         })
     };
     Ok(match shape.kind.as_str() {
@@ -481,7 +489,12 @@ fn shape_geometry(
         "obj" => (mesh(MeshFormat::Obj)?, &["filename", "to_world", "flip_normals", "face_normals", "flip_tex_coords"]),
         "ply" => (mesh(MeshFormat::Ply)?, &["filename", "to_world", "flip_normals", "face_normals"]),
         "glb" | "gltf" => (mesh(MeshFormat::Glb)?, &["filename", "to_world", "flip_normals", "face_normals"]),
-        other => return Err((shape.line, format!("shape type \"{other}\" is not supported (obj, ply, glb, sphere, rectangle, disk, cube)"))),
+        "serialized" => {
+            let index = shape.integer("shape_index", 0)?;
+            let shape_index = u32::try_from(index).map_err(|_| (shape.line, format!("shape_index must be a non-negative integer, got {index}")))?;
+            (mesh(MeshFormat::Serialized { shape_index })?, &["filename", "to_world", "flip_normals", "face_normals", "shape_index"])
+        }
+        other => return Err((shape.line, format!("shape type \"{other}\" is not supported (obj, ply, serialized, glb, sphere, rectangle, disk, cube)"))),
     })
 }
 

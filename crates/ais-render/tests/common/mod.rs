@@ -67,6 +67,7 @@ pub fn shipped_scenes() -> Result<PathBuf, String> {
         "ball.obj",
         "tiles.png",
         "quad.obj",
+        "shapes.serialized",
     ];
     if assets
         .iter()
