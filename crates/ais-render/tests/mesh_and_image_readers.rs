@@ -326,7 +326,7 @@ fn corrupt_serialized_files_are_refused_with_the_reason() {
         false,
         4,
     );
-    let good = serialized(&[body.clone()], 4);
+    let good = serialized(std::slice::from_ref(&body), 4);
     let mut wrong_header = good.clone();
     wrong_header[0] = 0;
     let mut short_body = body.clone();
