@@ -4,7 +4,7 @@ use crate::bsdf::{albedo_texture, Material, TextureScene};
 use crate::camera::Camera;
 use crate::error::InputError;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
-use crate::lights::reader::{scene_emitters, spectrum_property};
+use crate::lights::reader::{refuse_nested, scene_emitters, spectrum_property};
 use crate::lights::{AreaLight, AreaShape, Emitters, Lights, Rectangle};
 use crate::mesh::{load_mesh, validate, TriangleMesh};
 use crate::scene::{self, SceneDescription};
@@ -158,6 +158,7 @@ fn build_shape(
         .as_ref()
         .map(|e| {
             scene::warn_unknown(file, e, &["radiance"], warnings);
+            refuse_nested(file, e)?;
             spectrum_property(file, e, "radiance")
         })
         .transpose()?;

@@ -230,6 +230,8 @@ fn emitter_errors_name_file_line_and_problem() {
         ("<scene>\n<emitter type=\"directional\"><vector name=\"direction\" x=\"0\" y=\"0\" z=\"0\"/></emitter></scene>", "test.xml:2: directional light has no direction"),
         ("<scene>\n<emitter type=\"point\"><rgb name=\"intensity\" value=\"-1\"/></emitter></scene>", "test.xml:2: intensity must be finite and non-negative"),
         ("<scene>\n<emitter type=\"projector\"/></scene>", "test.xml:2: emitter type \"projector\" is not supported"),
+        ("<scene><emitter type=\"spot\">\n<texture type=\"bitmap\" name=\"texture\"/></emitter></scene>", "test.xml:2: a nested <texture> in a \"spot\" emitter is not supported"),
+        ("<scene><shape type=\"cube\"><emitter type=\"area\">\n<texture type=\"checkerboard\" name=\"radiance\"/></emitter></shape></scene>", "test.xml:2: a nested <texture> in a \"area\" emitter is not supported"),
     ];
     for (text, expected) in cases {
         let description = parse(text).expect("the file itself is well formed");
