@@ -51,6 +51,42 @@ pub fn disk() -> TriangleMesh {
     mesh
 }
 
+/// Facets around a cylinder. The flat facets lie within 1.2e-3 radii of the true surface
+/// and their normals within 2.8° of its normals; they keep their own normals (interpolated
+/// vertex normals send rays from near a facet's edge below its plane, into the cylinder).
+/// Finer facets meet at angles so shallow (under about 3°) that a shadow ray leaving near
+/// an edge, offset from the surface as every ray is, can still hit the next facet: at 256
+/// facets that darkened streaks along the cylinder by 30 standard errors against Mitsuba.
+pub const CYLINDER_SEGMENTS: u32 = 64;
+
+/// Mitsuba's cylinder of `radius` from `p0` to `p1` as flat-shaded triangles, open at both
+/// ends, normals outward, with texture coordinates (azimuth / 2π, distance along the axis / length). The
+/// azimuth's origin follows our basis around the axis, which matches Mitsuba's for an axis
+/// along z.
+pub fn cylinder(p0: DVec3, p1: DVec3, radius: f64) -> TriangleMesh {
+    let axis = p1 - p0;
+    let (x, y) = crate::geometry::basis(axis.normalize().as_vec3());
+    let (x, y) = (x.as_dvec3() * radius, y.as_dvec3() * radius);
+    let mut mesh = TriangleMesh::default();
+    let mut texcoords = Vec::new();
+    for i in 0..=CYLINDER_SEGMENTS {
+        let u = i as f64 / CYLINDER_SEGMENTS as f64;
+        let (sin, cos) = (std::f64::consts::TAU * u).sin_cos();
+        let radial = x * cos + y * sin;
+        for (end, v) in [(p0, 0.0), (p1, 1.0)] {
+            mesh.positions.push((end + radial).as_vec3());
+            texcoords.push(Vec2::new(u as f32, v));
+        }
+    }
+    for i in 0..CYLINDER_SEGMENTS {
+        let (a, b) = (2 * i, 2 * i + 2);
+        mesh.triangles.push([a, b, b + 1]);
+        mesh.triangles.push([a, b + 1, a + 1]);
+    }
+    mesh.texcoords = Some(texcoords);
+    mesh
+}
+
 /// The cube [-1, 1]³ with outward faces.
 pub fn cube() -> TriangleMesh {
     let mut mesh = TriangleMesh::default();

@@ -169,6 +169,7 @@ fn build_shape(
         scene::ShapeGeometry::Rectangle => shapes::rectangle(),
         scene::ShapeGeometry::Disk => shapes::disk(),
         scene::ShapeGeometry::Cube => shapes::cube(),
+        scene::ShapeGeometry::Cylinder { p0, p1, radius } => shapes::cylinder(*p0, *p1, *radius),
         scene::ShapeGeometry::Mesh {
             path,
             format,

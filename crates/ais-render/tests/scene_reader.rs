@@ -174,6 +174,8 @@ fn every_error_names_file_line_and_problem() {
         ("<scene>\n<shape type=\"obj\"/></scene>", "needs a \"filename\" string"),
         ("<scene><shape type=\"sphere\">\n<float name=\"radius\" value=\"abc\"/></shape></scene>", "test.xml:2: \"abc\" is not a number"),
         ("<scene><shape type=\"sphere\">\n<float name=\"radius\" value=\"-1\"/></shape></scene>", "radius must be positive"),
+        ("<scene>\n<shape type=\"cylinder\"><float name=\"radius\" value=\"0\"/></shape></scene>", "test.xml:2: cylinder radius must be positive"),
+        ("<scene>\n<shape type=\"cylinder\"><point name=\"p0\" x=\"0\" y=\"0\" z=\"1\"/></shape></scene>", "test.xml:2: cylinder p0 and p1 must be finite and distinct"),
         ("<scene><shape type=\"sphere\">\n<string name=\"radius\" value=\"1\"/></shape></scene>", "test.xml:2: property \"radius\" of shape \"sphere\" must be a float, not a string"),
         ("<scene><shape type=\"cube\">\n<boolean name=\"flip_normals\" value=\"yes\"/></shape></scene>", "\"yes\" is not true or false"),
         ("<scene><sensor type=\"perspective\"><film type=\"hdrfilm\">\n<integer name=\"width\" value=\"1.5\"/></film></sensor></scene>", "test.xml:2: \"1.5\" is not an integer"),

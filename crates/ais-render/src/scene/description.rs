@@ -72,6 +72,28 @@ pub enum MeshFormat {
     },
 }
 
+/// A `cylinder`: radius 1 from (0, 0, 0) to (0, 0, 1) unless told otherwise.
+fn cylinder(shape: &Plugin) -> Result<ShapeGeometry, (u32, String)> {
+    let radius = shape.float("radius", 1.0)?;
+    let (p0, p1) = (
+        shape.point("p0", DVec3::ZERO)?,
+        shape.point("p1", DVec3::Z)?,
+    );
+    if !(radius > 0.0 && radius.is_finite()) {
+        return Err((
+            shape.line,
+            format!("cylinder radius must be positive, got {radius}"),
+        ));
+    }
+    if !(p0.is_finite() && p1.is_finite()) || p0 == p1 {
+        return Err((
+            shape.line,
+            "cylinder p0 and p1 must be finite and distinct".into(),
+        ));
+    }
+    Ok(ShapeGeometry::Cylinder { p0, p1, radius })
+}
+
 /// The geometry of a shape.
 #[derive(Clone, Debug, PartialEq)]
 pub enum ShapeGeometry {
@@ -88,6 +110,15 @@ pub enum ShapeGeometry {
     Disk,
     /// The cube [-1, 1]³.
     Cube,
+    /// An open cylinder (no caps) of `radius` around the segment from `p0` to `p1`.
+    Cylinder {
+        /// Centre of one end.
+        p0: DVec3,
+        /// Centre of the other end.
+        p1: DVec3,
+        /// Radius.
+        radius: f64,
+    },
     /// A mesh file.
     Mesh {
         /// Resolved path.
@@ -486,6 +517,7 @@ fn shape_geometry(
         "rectangle" => (ShapeGeometry::Rectangle, &["to_world", "flip_normals"]),
         "disk" => (ShapeGeometry::Disk, &["to_world", "flip_normals"]),
         "cube" => (ShapeGeometry::Cube, &["to_world", "flip_normals"]),
+        "cylinder" => (cylinder(shape)?, &["radius", "p0", "p1", "to_world", "flip_normals"]),
         "obj" => (mesh(MeshFormat::Obj)?, &["filename", "to_world", "flip_normals", "face_normals", "flip_tex_coords"]),
         "ply" => (mesh(MeshFormat::Ply)?, &["filename", "to_world", "flip_normals", "face_normals"]),
         "glb" | "gltf" => (mesh(MeshFormat::Glb)?, &["filename", "to_world", "flip_normals", "face_normals"]),
@@ -494,7 +526,7 @@ fn shape_geometry(
             let shape_index = u32::try_from(index).map_err(|_| (shape.line, format!("shape_index must be a non-negative integer, got {index}")))?;
             (mesh(MeshFormat::Serialized { shape_index })?, &["filename", "to_world", "flip_normals", "face_normals", "shape_index"])
         }
-        other => return Err((shape.line, format!("shape type \"{other}\" is not supported (obj, ply, serialized, glb, sphere, rectangle, disk, cube)"))),
+        other => return Err((shape.line, format!("shape type \"{other}\" is not supported (obj, ply, serialized, glb, sphere, rectangle, disk, cube, cylinder)"))),
     })
 }
 
