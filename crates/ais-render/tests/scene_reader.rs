@@ -223,6 +223,20 @@ fn a_truncated_file_says_so() {
     assert!(e.contains("is it truncated?"), "{e}");
 }
 
+/// Asserts that the scene `text` parses but cannot become a world, with an error that says
+/// `expected`.
+fn assert_world_refuses(text: &str, expected: &str) {
+    let description = parse(text).expect("the file itself is well formed");
+    let Err(e) = ais_render::world::World::from_description(description) else {
+        panic!("{text} should be refused");
+    };
+    let message = e.to_string();
+    assert!(
+        message.contains(expected),
+        "for {text}\n got: {message}\n want: {expected}"
+    );
+}
+
 #[test]
 fn emitter_errors_name_file_line_and_problem() {
     let cases: &[(&str, &str)] = &[
@@ -236,15 +250,7 @@ fn emitter_errors_name_file_line_and_problem() {
         ("<scene><shape type=\"cube\"><emitter type=\"area\">\n<texture type=\"checkerboard\" name=\"radiance\"/></emitter></shape></scene>", "test.xml:2: a nested <texture> in a \"area\" emitter is not supported"),
     ];
     for (text, expected) in cases {
-        let description = parse(text).expect("the file itself is well formed");
-        let Err(e) = ais_render::world::World::from_description(description) else {
-            panic!("{text} should be refused");
-        };
-        let message = e.to_string();
-        assert!(
-            message.contains(expected),
-            "for {text}\n got: {message}\n want: {expected}"
-        );
+        assert_world_refuses(text, expected);
     }
 }
 
@@ -342,15 +348,7 @@ fn texture_errors_name_file_line_and_problem() {
         ),
     ];
     for (text, expected) in &cases {
-        let description = parse(text).expect("the file itself is well formed");
-        let Err(e) = ais_render::world::World::from_description(description) else {
-            panic!("{text} should be refused");
-        };
-        let message = e.to_string();
-        assert!(
-            message.contains(expected),
-            "for {text}\n got: {message}\n want: {expected}"
-        );
+        assert_world_refuses(text, expected);
     }
 }
 

@@ -44,6 +44,18 @@ pub fn load_mesh(path: &Path, format: MeshFormat) -> Result<LoadedMesh, InputErr
     validate(path, mesh)
 }
 
+/// Whether a per-vertex attribute, if present, has one finite value per vertex; one that
+/// has not is removed (and false returned).
+fn usable<T>(attribute: &mut Option<Vec<T>>, vertices: usize, finite: impl Fn(&T) -> bool) -> bool {
+    let bad = attribute
+        .as_ref()
+        .is_some_and(|values| values.len() != vertices || !values.iter().all(&finite));
+    if bad {
+        *attribute = None;
+    }
+    !bad
+}
+
 /// The largest coordinate a scene may use, in world units: beyond it the BVH's single
 /// precision bounds lose every digit of a typical triangle.
 pub const LARGEST_COORDINATE: f32 = 1e12;
@@ -85,23 +97,18 @@ pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, Input
             format!("triangle {t} refers to a vertex beyond the {count} vertices"),
         ));
     }
-    if let Some(normals) = &mesh.normals {
-        if normals.len() != mesh.positions.len() || normals.iter().any(|n| !n.is_finite()) {
-            warnings.push(format!(
-                "{}: vertex normals are incomplete or not finite; using face normals",
-                path.display()
-            ));
-            mesh.normals = None;
-        }
+    let vertices = mesh.positions.len();
+    if !usable(&mut mesh.normals, vertices, |n| n.is_finite()) {
+        warnings.push(format!(
+            "{}: vertex normals are incomplete or not finite; using face normals",
+            path.display()
+        ));
     }
-    if let Some(texcoords) = &mesh.texcoords {
-        if texcoords.len() != mesh.positions.len() || texcoords.iter().any(|t| !t.is_finite()) {
-            warnings.push(format!(
-                "{}: texture coordinates are incomplete or not finite; the mesh has none",
-                path.display()
-            ));
-            mesh.texcoords = None;
-        }
+    if !usable(&mut mesh.texcoords, vertices, |t| t.is_finite()) {
+        warnings.push(format!(
+            "{}: texture coordinates are incomplete or not finite; the mesh has none",
+            path.display()
+        ));
     }
     let before = mesh.triangles.len();
     let positions = &mesh.positions;
