@@ -174,17 +174,7 @@ fn build_shape(
             path,
             format,
             flip_tex_coords,
-        } => {
-            let mut loaded = load_mesh(path, *format)?;
-            warnings.extend(loaded.warnings);
-            // The OBJ reader flips v, as Mitsuba does unless told not to.
-            if *format == scene::MeshFormat::Obj && !flip_tex_coords {
-                for t in loaded.mesh.texcoords.iter_mut().flatten() {
-                    t.y = 1.0 - t.y;
-                }
-            }
-            loaded.mesh
-        }
+        } => mesh_file(path, *format, *flip_tex_coords, warnings)?,
     };
     let mesh = mesh.transformed(shape.to_world, shape.face_normals, shape.flip_normals);
     // A transform can collapse triangles (e.g. a zero scale): validate again.
@@ -271,6 +261,24 @@ impl World {
             warnings,
         })
     }
+}
+
+/// A mesh file's mesh, with v unflipped for an OBJ that says `flip_tex_coords = false` (the
+/// OBJ reader flips it, as Mitsuba does by default).
+fn mesh_file(
+    path: &std::path::Path,
+    format: scene::MeshFormat,
+    flip_tex_coords: bool,
+    warnings: &mut Vec<String>,
+) -> Result<TriangleMesh, InputError> {
+    let mut loaded = load_mesh(path, format)?;
+    warnings.extend(loaded.warnings);
+    if format == scene::MeshFormat::Obj && !flip_tex_coords {
+        for t in loaded.mesh.texcoords.iter_mut().flatten() {
+            t.y = 1.0 - t.y;
+        }
+    }
+    Ok(loaded.mesh)
 }
 
 /// A mesh as an area light: a rectangle (Mitsuba's `rectangle` shape, edges still

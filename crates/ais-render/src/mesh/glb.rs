@@ -85,21 +85,25 @@ impl Assembly<'_> {
         }
         let count = positions.len() as u32;
         self.mesh.positions.extend(positions);
-        match reader.read_indices() {
-            Some(indices) => {
-                let indices: Vec<u32> = indices.into_u32().collect();
-                self.mesh.triangles.extend(
-                    indices
-                        .chunks_exact(3)
-                        .map(|t| [base + t[0], base + t[1], base + t[2]]),
-                );
-            }
+        let indices: Option<Vec<u32>> = reader.read_indices().map(|i| i.into_u32().collect());
+        self.add_triangles(indices, base, count);
+        Ok(())
+    }
+
+    /// Appends a primitive's triangles: from its `indices`, or (without them) its `count`
+    /// vertices taken three by three; `base` is its first vertex in the mesh.
+    fn add_triangles(&mut self, indices: Option<Vec<u32>>, base: u32, count: u32) {
+        match indices {
+            Some(indices) => self.mesh.triangles.extend(
+                indices
+                    .chunks_exact(3)
+                    .map(|t| [base + t[0], base + t[1], base + t[2]]),
+            ),
             None => self
                 .mesh
                 .triangles
                 .extend((0..count / 3).map(|t| [base + 3 * t, base + 3 * t + 1, base + 3 * t + 2])),
         }
-        Ok(())
     }
 }
 

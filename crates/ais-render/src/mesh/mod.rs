@@ -44,27 +44,8 @@ pub fn load_mesh(path: &Path, format: MeshFormat) -> Result<LoadedMesh, InputErr
     validate(path, mesh)
 }
 
-/// Whether a per-vertex attribute, if present, has one finite value per vertex; one that
-/// has not is removed (and false returned).
-fn usable<T>(attribute: &mut Option<Vec<T>>, vertices: usize, finite: impl Fn(&T) -> bool) -> bool {
-    let bad = attribute
-        .as_ref()
-        .is_some_and(|values| values.len() != vertices || !values.iter().all(&finite));
-    if bad {
-        *attribute = None;
-    }
-    !bad
-}
-
-/// The largest coordinate a scene may use, in world units: beyond it the BVH's single
-/// precision bounds lose every digit of a typical triangle.
-pub const LARGEST_COORDINATE: f32 = 1e12;
-
-/// Checks a mesh: positions finite and within ±[`LARGEST_COORDINATE`], indices in range,
-/// normals usable; degenerate triangles (zero area) are dropped with a warning; an empty
-/// result is an error.
-pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, InputError> {
-    let mut warnings = Vec::new();
+/// Refuses non-finite or absurdly large positions and indices beyond the vertices.
+fn check_positions_and_indices(path: &Path, mesh: &TriangleMesh) -> Result<(), InputError> {
     if let Some(index) = mesh.positions.iter().position(|p| !p.is_finite()) {
         return Err(InputError::new(
             path,
@@ -97,6 +78,31 @@ pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, Input
             format!("triangle {t} refers to a vertex beyond the {count} vertices"),
         ));
     }
+    Ok(())
+}
+
+/// Whether a per-vertex attribute, if present, has one finite value per vertex; one that
+/// has not is removed (and false returned).
+fn usable<T>(attribute: &mut Option<Vec<T>>, vertices: usize, finite: impl Fn(&T) -> bool) -> bool {
+    let bad = attribute
+        .as_ref()
+        .is_some_and(|values| values.len() != vertices || !values.iter().all(&finite));
+    if bad {
+        *attribute = None;
+    }
+    !bad
+}
+
+/// The largest coordinate a scene may use, in world units: beyond it the BVH's single
+/// precision bounds lose every digit of a typical triangle.
+pub const LARGEST_COORDINATE: f32 = 1e12;
+
+/// Checks a mesh: positions finite and within ±[`LARGEST_COORDINATE`], indices in range,
+/// normals usable; degenerate triangles (zero area) are dropped with a warning; an empty
+/// result is an error.
+pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, InputError> {
+    let mut warnings = Vec::new();
+    check_positions_and_indices(path, &mesh)?;
     let vertices = mesh.positions.len();
     if !usable(&mut mesh.normals, vertices, |n| n.is_finite()) {
         warnings.push(format!(

@@ -215,23 +215,8 @@ pub fn parse_scene(
         files: FileResolver::new(path, &parsed.paths),
     };
     let files = scene.files.clone();
-    // BSDFs first so that shapes may reference ones declared after them.
-    for plugin in parsed.plugins.iter().filter(|p| p.tag == "bsdf") {
-        if plugin.id.is_none() {
-            scene.warnings.push(format!(
-                "{}:{}: a top-level <bsdf> without an id can never be used",
-                path.display(),
-                plugin.line
-            ));
-        }
-        scene.bsdfs.push(plugin.clone());
-    }
-    scene.textures = parsed
-        .plugins
-        .iter()
-        .filter(|p| p.tag == "texture")
-        .cloned()
-        .collect();
+    // BSDFs and textures first so that shapes may reference ones declared after them.
+    collect_referenced(path, &parsed.plugins, &mut scene);
     let mut sensor_seen = false;
     for plugin in &parsed.plugins {
         if plugin.tag == "sensor" {
@@ -253,6 +238,25 @@ pub fn parse_scene(
         ));
     }
     Ok(scene)
+}
+
+/// The top-level BSDFs and textures, which shapes and BSDFs reference by id.
+fn collect_referenced(path: &Path, plugins: &[Plugin], scene: &mut SceneDescription) {
+    for plugin in plugins.iter().filter(|p| p.tag == "bsdf") {
+        if plugin.id.is_none() {
+            scene.warnings.push(format!(
+                "{}:{}: a top-level <bsdf> without an id can never be used",
+                path.display(),
+                plugin.line
+            ));
+        }
+        scene.bsdfs.push(plugin.clone());
+    }
+    scene.textures = plugins
+        .iter()
+        .filter(|p| p.tag == "texture")
+        .cloned()
+        .collect();
 }
 
 /// One top-level element other than a BSDF (read before the rest).
