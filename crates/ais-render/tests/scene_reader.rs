@@ -165,7 +165,8 @@ fn every_error_names_file_line_and_problem() {
         ("<scene><shape type=\"cube\"></scene>", "malformed XML"),
         ("<world/>", "root element must be <scene>"),
         ("<scene>\n<medium type=\"homogeneous\"/></scene>", "test.xml:2: <medium> is not supported"),
-        ("<scene>\n<include filename=\"x.xml\"/></scene>", "<include> is not supported"),
+        ("<scene>\n<include filename=\"x.xml\"/></scene>", "test.xml:2: the included file /scenes/x.xml does not exist"),
+        ("<scene><shape type=\"cube\">\n<include filename=\"x.xml\"/></shape></scene>", "test.xml:2: <include> is only supported at scene level"),
         ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" value=\"400:1, 700:2\"/></emitter></scene>", "test.xml:2: a <spectrum> of wavelength:value pairs is not supported"),
         ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" filename=\"d65.spd\"/></emitter></scene>", "test.xml:2: a <spectrum> read from a file is not supported"),
         ("<scene>\n<banana/></scene>", "test.xml:2: unexpected element <banana> in <scene>"),
@@ -383,4 +384,67 @@ fn textures_reach_the_albedo_and_warn_where_they_do_not() {
         "{:?}",
         world.warnings
     );
+}
+
+#[test]
+fn include_reads_other_files_with_their_defaults_and_refuses_cycles() {
+    let folder = std::env::temp_dir().join(format!("ais-include-{}", std::process::id()));
+    std::fs::create_dir_all(folder.join("parts")).unwrap();
+    let write = |name: &str, text: &str| std::fs::write(folder.join(name), text).unwrap();
+    // parts/room.xml includes parts/preamble.xml by a name relative to the top file's folder,
+    // as Mitsuba's scenes do, and uses the default that file sets.
+    write(
+        "parts/preamble.xml",
+        r#"<scene version="3.0.0"><default name="size" value="2"/></scene>"#,
+    );
+    write(
+        "parts/room.xml",
+        r#"<scene version="3.0.0"><include filename="parts/preamble.xml"/>
+        <shape type="sphere"><float name="radius" value="$size"/></shape></scene>"#,
+    );
+    write(
+        "main.xml",
+        "<scene version=\"3.0.0\">\n<include filename=\"parts/room.xml\"/>\n<shape type=\"cube\"/></scene>",
+    );
+    let scene = ais_render::scene::load_scene(&folder.join("main.xml"), &[]).unwrap();
+    assert_eq!(scene.shapes.len(), 2);
+    match scene.shapes[0].geometry {
+        ShapeGeometry::Sphere { radius, .. } => assert_eq!(radius, 2.0),
+        ref other => panic!("{other:?}"),
+    }
+    // Later messages about included elements point at the <include>.
+    assert_eq!(scene.shapes[0].line, 2);
+    write(
+        "parts/a.xml",
+        r#"<scene version="3.0.0"><include filename="b.xml"/></scene>"#,
+    );
+    write(
+        "parts/b.xml",
+        r#"<scene version="3.0.0"><include filename="a.xml"/></scene>"#,
+    );
+    write(
+        "cycle.xml",
+        r#"<scene version="3.0.0"><include filename="parts/a.xml"/></scene>"#,
+    );
+    let e = ais_render::scene::load_scene(&folder.join("cycle.xml"), &[]).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("include one another more than 16 deep"),
+        "{e}"
+    );
+    write(
+        "parts/broken.xml",
+        "<scene version=\"3.0.0\">\n<shape type=\"teapot\"/></scene>",
+    );
+    write(
+        "uses_broken.xml",
+        r#"<scene version="3.0.0"><include filename="parts/broken.xml"/></scene>"#,
+    );
+    let e = ais_render::scene::load_scene(&folder.join("uses_broken.xml"), &[]).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains("shape type \"teapot\" is not supported"),
+        "{e}"
+    );
+    std::fs::remove_dir_all(&folder).unwrap();
 }

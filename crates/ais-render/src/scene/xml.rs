@@ -21,7 +21,10 @@ const PLUGIN_TAGS: &[&str] = &[
 ];
 
 /// Tags of Mitsuba that this reader refuses with a clear error rather than ignore.
-const UNSUPPORTED_TAGS: &[&str] = &["medium", "phase", "volume", "include", "alias"];
+const UNSUPPORTED_TAGS: &[&str] = &["medium", "phase", "volume", "alias"];
+
+/// How deeply files may include one another (deeper is taken for a cycle).
+const DEEPEST_INCLUDE: usize = 16;
 
 /// The deepest nesting of plugins a scene may use (Mitsuba's scenes nest a handful).
 pub const DEEPEST_NESTING: usize = 64;
@@ -38,6 +41,9 @@ pub struct ParsedScene {
 
 struct Reader<'a> {
     file: &'a Path,
+    /// The scene file the reading started from (an included file's names may be relative to
+    /// its folder, as Mitsuba's file resolver makes them).
+    top: &'a Path,
     text: &'a str,
     parameters: HashMap<String, String>,
     /// The parameters a `$name` has used.
@@ -51,6 +57,7 @@ fn known_attributes(tag: &str) -> &'static [&'static str] {
         "float" | "integer" | "boolean" | "string" | "rgb" => &["name", "value"],
         "spectrum" => &["name", "value", "filename"],
         "path" => &["value"],
+        "include" => &["filename"],
         "point" | "vector" => &["name", "value", "x", "y", "z"],
         "transform" => &["name"],
         "ref" => &["id", "name"],
@@ -66,7 +73,31 @@ pub fn parse(
     text: &str,
     overrides: &[(String, String)],
 ) -> Result<ParsedScene, InputError> {
-    let document = roxmltree::Document::parse(text).map_err(|e| {
+    let parameters = overrides.iter().cloned().collect();
+    let used = Default::default();
+    let mut reader = Reader {
+        file,
+        top: file,
+        text,
+        parameters,
+        used,
+        warnings: Vec::new(),
+    };
+    let mut scene = ParsedScene {
+        plugins: Vec::new(),
+        warnings: Vec::new(),
+        paths: Vec::new(),
+    };
+    reader.read_scene(overrides, &mut scene, 0)?;
+    reader.warn_unused_overrides(overrides);
+    scene.warnings = reader.warnings;
+    check_unique_ids(file, &scene.plugins)?;
+    Ok(scene)
+}
+
+/// The XML document in `text`, read from `file`.
+fn document<'t>(file: &Path, text: &'t str) -> Result<roxmltree::Document<'t>, InputError> {
+    roxmltree::Document::parse(text).map_err(|e| {
         let position = e.pos();
         let hint = match e {
             roxmltree::Error::UnexpectedEndOfStream => {
@@ -75,50 +106,16 @@ pub fn parse(
             _ => "",
         };
         InputError::at(file, position.row, format!("malformed XML: {e}{hint}"))
-    })?;
-    let root = document.root_element();
-    let mut reader = Reader {
-        file,
-        text,
-        parameters: overrides.iter().cloned().collect(),
-        used: Default::default(),
-        warnings: Vec::new(),
-    };
-    if root.tag_name().name() != "scene" {
-        return Err(reader.error(
-            root,
-            format!(
-                "the root element must be <scene>, found <{}>",
-                root.tag_name().name()
-            ),
-        ));
-    }
-    reader.read_defaults(root, overrides)?;
-    let mut plugins = Vec::new();
-    let mut paths = Vec::new();
-    for child in root.children().filter(|n| n.is_element()) {
-        let tag = child.tag_name().name();
-        if tag == "default" {
-            continue;
-        }
-        if tag == "path" {
-            reader.warn_unknown_attributes(child);
-            paths.push(reader.attribute(child, "value")?);
-        } else if PLUGIN_TAGS.contains(&tag) {
-            plugins.push(reader.plugin(child, 1)?);
-        } else if tag == "ref" {
-            return Err(reader.error(child, "a <ref> at scene level refers to nothing"));
-        } else {
-            return Err(reader.unexpected(child, "<scene>"));
-        }
-    }
-    reader.warn_unused_overrides(overrides);
-    check_unique_ids(file, &plugins)?;
-    Ok(ParsedScene {
-        plugins,
-        warnings: reader.warnings,
-        paths,
     })
+}
+
+/// Sets every line of `plugin` (its own, its properties', its references', its children's)
+/// to `line`.
+fn relocate(plugin: &mut Plugin, line: u32) {
+    plugin.line = line;
+    plugin.properties.values_mut().for_each(|p| p.line = line);
+    plugin.references.iter_mut().for_each(|r| r.2 = line);
+    plugin.children.iter_mut().for_each(|c| relocate(c, line));
 }
 
 /// Refuses two plugins with the same id: a reference to it would be ambiguous.
@@ -149,8 +146,126 @@ fn check_unique_ids(file: &Path, plugins: &[Plugin]) -> Result<(), InputError> {
 }
 
 impl<'a> Reader<'a> {
+    /// Reads this reader's file (included `depth` files deep) into `scene`: its defaults,
+    /// `<path>`s, plugins and the files it includes.
+    fn read_scene(
+        &mut self,
+        overrides: &[(String, String)],
+        scene: &mut ParsedScene,
+        depth: usize,
+    ) -> Result<(), InputError> {
+        let text = self.text;
+        let document = document(self.file, text)?;
+        let root = document.root_element();
+        if root.tag_name().name() != "scene" {
+            return Err(self.error(
+                root,
+                format!(
+                    "the root element must be <scene>, found <{}>",
+                    root.tag_name().name()
+                ),
+            ));
+        }
+        self.read_defaults(root, overrides)?;
+        for child in root.children().filter(|n| n.is_element()) {
+            match child.tag_name().name() {
+                "default" => {}
+                "path" => {
+                    self.warn_unknown_attributes(child);
+                    scene.paths.push(self.path_value(child, depth)?);
+                }
+                "include" => self.include(child, overrides, scene, depth)?,
+                "ref" => return Err(self.error(child, "a <ref> at scene level refers to nothing")),
+                tag if PLUGIN_TAGS.contains(&tag) => scene.plugins.push(self.plugin(child, 1)?),
+                _ => return Err(self.unexpected(child, "<scene>")),
+            }
+        }
+        Ok(())
+    }
+
+    /// A `<path>`'s folder: as written in the scene file, or made absolute against the
+    /// folder of an included file.
+    fn path_value(&self, node: roxmltree::Node, depth: usize) -> Result<String, InputError> {
+        let value = self.attribute(node, "value")?;
+        if depth == 0 || Path::new(&value).is_absolute() {
+            return Ok(value);
+        }
+        let folder = self.file.parent().unwrap_or(Path::new("."));
+        Ok(folder.join(value).to_string_lossy().into_owned())
+    }
+
+    /// Reads the scene file an `<include>` names (beside this file, else beside the scene
+    /// file the reading started from) into
+    /// `scene`. Its elements count as written at the `<include>`: later messages about them
+    /// name this file and the `<include>`'s line; problems in the included file's own XML
+    /// name that file and line.
+    fn include(
+        &mut self,
+        node: roxmltree::Node,
+        overrides: &[(String, String)],
+        scene: &mut ParsedScene,
+        depth: usize,
+    ) -> Result<(), InputError> {
+        self.warn_unknown_attributes(node);
+        if depth + 1 > DEEPEST_INCLUDE {
+            return Err(self.error(
+                node,
+                format!("files include one another more than {DEEPEST_INCLUDE} deep: a cycle?"),
+            ));
+        }
+        let name = self.attribute(node, "filename")?;
+        let folder = |file: &Path| file.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let beside = folder(self.file).join(&name);
+        let path = if beside.exists() {
+            beside
+        } else {
+            folder(self.top).join(&name)
+        };
+        if !path.exists() {
+            return Err(self.error(
+                node,
+                format!("the included file {} does not exist", path.display()),
+            ));
+        }
+        crate::error::check_input_file(&path, "included scene file")?;
+        let text = std::fs::read_to_string(&path).map_err(|e| {
+            self.error(
+                node,
+                format!("cannot read included {}: {e}", path.display()),
+            )
+        })?;
+        let mut included = Reader {
+            file: &path,
+            top: self.top,
+            text: &text,
+            parameters: self.parameters.clone(),
+            used: Default::default(),
+            warnings: Vec::new(),
+        };
+        let mut inner = ParsedScene {
+            plugins: Vec::new(),
+            warnings: Vec::new(),
+            paths: Vec::new(),
+        };
+        included.read_scene(overrides, &mut inner, depth + 1)?;
+        // Its defaults hold for the rest of the including file too.
+        for (name, value) in std::mem::take(&mut included.parameters) {
+            self.parameters.entry(name).or_insert(value);
+        }
+        self.used.borrow_mut().extend(included.used.take());
+        self.warnings.append(&mut included.warnings);
+        let line = self.line(node);
+        for mut plugin in inner.plugins {
+            relocate(&mut plugin, line);
+            scene.plugins.push(plugin);
+        }
+        scene.paths.extend(inner.paths);
+        Ok(())
+    }
+
     /// Reads the `<default>`s, wherever they are, so that they apply to the whole file;
-    /// command-line overrides win, and a second default of one name warns.
+    /// command-line overrides and an including file's parameters win, and a second default
+    /// of one name warns.
     fn read_defaults(
         &mut self,
         root: roxmltree::Node,
@@ -171,8 +286,11 @@ impl<'a> Reader<'a> {
                 ));
                 continue;
             }
+            // Command-line values, and the including file's, come first (as in Mitsuba).
             if !overrides.iter().any(|(n, _)| n == name) {
-                self.parameters.insert(name.to_string(), value.to_string());
+                self.parameters
+                    .entry(name.to_string())
+                    .or_insert_with(|| value.to_string());
             }
         }
         Ok(())
@@ -313,6 +431,8 @@ impl<'a> Reader<'a> {
                 plugin.references.push((name, id, self.line(child)));
             } else if child_tag == "default" {
                 return Err(self.error(child, "<default> must be a direct child of <scene>"));
+            } else if child_tag == "include" {
+                return Err(self.error(child, "<include> is only supported at scene level"));
             } else {
                 self.warn_unknown_attributes(child);
                 let name = self.attribute(child, "name")?;
