@@ -213,6 +213,7 @@ pub fn default_world(width: u32, height: u32) -> World {
         shapes: Vec::new(),
         bsdfs: Vec::new(),
         textures: Vec::new(),
+        referable: Vec::new(),
         emitters: Vec::new(),
         integrator: None,
         warnings: Vec::new(),

@@ -448,3 +448,20 @@ fn include_reads_other_files_with_their_defaults_and_refuses_cycles() {
     );
     std::fs::remove_dir_all(&folder).unwrap();
 }
+
+#[test]
+fn a_sensor_may_reference_a_scene_level_sampler_and_film() {
+    let text = r#"<scene>
+        <sampler type="independent" id="s"><integer name="sample_count" value="25"/></sampler>
+        <film type="hdrfilm" id="f"><integer name="width" value="40"/><integer name="height" value="30"/></film>
+        <sensor type="perspective"><ref id="s"/><ref id="f"/></sensor></scene>"#;
+    let scene = parse(text).unwrap();
+    assert_eq!(scene.sample_count, 25);
+    assert_eq!(scene.resolution, (40, 30));
+    let message =
+        error("<scene><sensor type=\"perspective\">\n<ref id=\"nothing\"/></sensor></scene>");
+    assert!(
+        message.contains("test.xml:2: no <film> or <sampler> with id \"nothing\""),
+        "{message}"
+    );
+}

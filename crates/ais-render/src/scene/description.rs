@@ -166,6 +166,8 @@ pub struct SceneDescription {
     pub bsdfs: Vec<Plugin>,
     /// Top-level textures, which BSDFs reference by id.
     pub textures: Vec<Plugin>,
+    /// Top-level films and samplers, which a sensor references by id.
+    pub referable: Vec<Plugin>,
     /// Scene-level emitters (`envmap`, `constant`, …), carried for the lighting code.
     pub emitters: Vec<Plugin>,
     /// Where its relative file names point (`<path>` elements, then its folder).
@@ -209,6 +211,7 @@ pub fn parse_scene(
         shapes: Vec::new(),
         bsdfs: Vec::new(),
         textures: Vec::new(),
+        referable: Vec::new(),
         emitters: Vec::new(),
         integrator: None,
         warnings: parsed.warnings,
@@ -240,7 +243,7 @@ pub fn parse_scene(
     Ok(scene)
 }
 
-/// The top-level BSDFs and textures, which shapes and BSDFs reference by id.
+/// The top-level BSDFs, textures, films and samplers, which other plugins reference by id.
 fn collect_referenced(path: &Path, plugins: &[Plugin], scene: &mut SceneDescription) {
     for plugin in plugins.iter().filter(|p| p.tag == "bsdf") {
         if plugin.id.is_none() {
@@ -252,11 +255,15 @@ fn collect_referenced(path: &Path, plugins: &[Plugin], scene: &mut SceneDescript
         }
         scene.bsdfs.push(plugin.clone());
     }
-    scene.textures = plugins
-        .iter()
-        .filter(|p| p.tag == "texture")
-        .cloned()
-        .collect();
+    let of = |tags: &[&str]| -> Vec<Plugin> {
+        plugins
+            .iter()
+            .filter(|p| tags.contains(&p.tag.as_str()))
+            .cloned()
+            .collect()
+    };
+    scene.textures = of(&["texture"]);
+    scene.referable = of(&["film", "sampler"]);
 }
 
 /// One top-level element other than a BSDF (read before the rest).
@@ -268,7 +275,7 @@ fn read_top_level(
 ) -> Result<(), InputError> {
     let at = |(line, message): (u32, String)| InputError::at(path, line, message);
     match plugin.tag.as_str() {
-        "bsdf" | "texture" => {}
+        "bsdf" | "texture" | "film" | "sampler" => {}
         "sensor" => read_sensor(path, plugin, scene).map_err(at)?,
         "shape" => {
             let shape = read_shape(path, files, plugin, scene).map_err(at)?;
@@ -300,7 +307,16 @@ fn read_sensor(
     scene: &mut SceneDescription,
 ) -> Result<(), (u32, String)> {
     scene.camera = read_camera(path, sensor, &mut scene.warnings)?;
-    for child in &sensor.children {
+    // A film or sampler may be declared at scene level and referenced by id.
+    let mut parts: Vec<&Plugin> = sensor.children.iter().collect();
+    for (_, id, line) in &sensor.references {
+        let found = scene
+            .referable
+            .iter()
+            .find(|p| p.id.as_deref() == Some(id.as_str()));
+        parts.push(found.ok_or((*line, format!("no <film> or <sampler> with id \"{id}\"")))?);
+    }
+    for child in parts {
         match child.tag.as_str() {
             "film" => scene.resolution = read_film(path, child, &mut scene.warnings)?,
             "sampler" => {
