@@ -13,7 +13,7 @@
 
 use crate::error::InputError;
 use crate::image_io::{read_image, RgbImage};
-use crate::scene::{FileResolver, Plugin, Property};
+use crate::scene::{ColourRole, FileResolver, Plugin};
 use glam::{DMat4, Vec2, Vec3};
 use std::path::Path;
 
@@ -205,15 +205,9 @@ fn colour_property(
             format!("a texture inside a texture (\"{name}\") is not supported"),
         ));
     }
-    match plugin.properties.get(name).map(|p| &p.value) {
-        None => Ok(Vec3::splat(default)),
-        Some(Property::Rgb(c)) => Ok(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)),
-        Some(Property::Float(v)) => Ok(Vec3::splat(*v as f32)),
-        Some(other) => Err(InputError::at(
-            file,
-            plugin.line,
-            format!("\"{name}\" must be an rgb or float, not a {}", other.kind()),
-        )),
+    match plugin.colour(name, ColourRole::Reflectance) {
+        Ok(value) => Ok(value.unwrap_or(Vec3::splat(default))),
+        Err((line, message)) => Err(InputError::at(file, line, message)),
     }
 }
 

@@ -150,13 +150,29 @@ fn ignored_properties_and_filters_are_warned_about() {
 }
 
 #[test]
-fn a_uniform_spectrum_is_its_value_in_every_channel() {
+fn spectra_become_colours_as_mitsubas_rgb_variants_make_them() {
+    use ais_render::scene::ColourRole;
     let scene = parse(
-        "<scene><emitter type=\"constant\"><spectrum name=\"radiance\" value=\"0.25\"/></emitter></scene>",
+        "<scene><emitter type=\"constant\"><spectrum name=\"radiance\" value=\"0.25\"/></emitter>
+         <bsdf type=\"diffuse\" id=\"paint\"><spectrum name=\"reflectance\" value=\"0.25\"/></bsdf>
+         <bsdf type=\"diffuse\" id=\"red\">
+           <spectrum name=\"reflectance\" value=\"400:0.04, 500:0.058, 600:0.287, 700:0.642\"/></bsdf>
+         </scene>",
     )
     .unwrap();
-    let radiance = &scene.emitters[0].properties["radiance"].value;
-    assert_eq!(*radiance, ais_render::scene::Property::Rgb([0.25; 3]));
+    let colour = |plugin: &ais_render::scene::Plugin, name, role| {
+        plugin.colour(name, role).unwrap().unwrap().to_array()
+    };
+    // A flat emission spectrum is not white in sRGB: value × sRGB of the equal-energy white.
+    let radiance = colour(&scene.emitters[0], "radiance", ColourRole::Emission);
+    let expected = [1.204794f32, 0.948291, 0.908916].map(|c| 0.25 * c);
+    for (r, e) in radiance.iter().zip(expected) {
+        assert!((r - e).abs() < 1e-5, "{radiance:?}");
+    }
+    let paint = colour(&scene.bsdfs[0], "reflectance", ColourRole::Reflectance);
+    assert_eq!(paint, [0.25; 3]);
+    let red = colour(&scene.bsdfs[1], "reflectance", ColourRole::Reflectance);
+    assert!(red[0] > 0.3 && red[1] < 0.2 && red[2] < 0.1, "{red:?}");
 }
 
 #[test]
@@ -167,8 +183,8 @@ fn every_error_names_file_line_and_problem() {
         ("<scene>\n<medium type=\"homogeneous\"/></scene>", "test.xml:2: <medium> is not supported"),
         ("<scene>\n<include filename=\"x.xml\"/></scene>", "test.xml:2: the included file /scenes/x.xml does not exist"),
         ("<scene><shape type=\"cube\">\n<include filename=\"x.xml\"/></shape></scene>", "test.xml:2: <include> is only supported at scene level"),
-        ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" value=\"400:1, 700:2\"/></emitter></scene>", "test.xml:2: a <spectrum> of wavelength:value pairs is not supported"),
-        ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" filename=\"d65.spd\"/></emitter></scene>", "test.xml:2: a <spectrum> read from a file is not supported"),
+        ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" value=\"700:1, 400:2\"/></emitter></scene>", "test.xml:2: wavelengths must increase, but 400 follows 700"),
+        ("<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" filename=\"d65.spd\"/></emitter></scene>", "test.xml:2: cannot read the spectrum file /scenes/d65.spd"),
         ("<scene>\n<banana/></scene>", "test.xml:2: unexpected element <banana> in <scene>"),
         ("<scene>\n<shape/></scene>", "test.xml:2: <shape> needs a \"type\" attribute"),
         ("<scene>\n<shape type=\"teapot\"/></scene>", "test.xml:2: shape type \"teapot\" is not supported"),
@@ -189,7 +205,7 @@ fn every_error_names_file_line_and_problem() {
         ("<scene><sensor type=\"perspective\"><film type=\"ldrfilm\"/></sensor></scene>", "film type \"ldrfilm\" is not supported"),
         ("<scene><sensor type=\"perspective\"><sampler type=\"independent\"><integer name=\"sample_count\" value=\"0\"/></sampler></sensor></scene>", "sample_count must be at least 1"),
         ("<scene><sensor type=\"perspective\"/><sensor type=\"perspective\"/></scene>", "only one <sensor>"),
-        ("<scene><shape type=\"cube\">\n<ref id=\"nothing\"/></shape></scene>", "test.xml:2: no <bsdf> with id \"nothing\""),
+        ("<scene><shape type=\"cube\">\n<ref id=\"nothing\"/></shape></scene>", "test.xml:2: no <bsdf> or area <emitter> with id \"nothing\""),
         ("<scene>\n<emitter type=\"area\"/></scene>", "test.xml:2: an area emitter must be nested in a <shape>"),
         ("<scene><shape type=\"cube\">\n<emitter type=\"envmap\"/></shape></scene>", "can only carry an area emitter"),
         ("<scene><shape type=\"cube\"><float name=\"x\" value=\"$missing\"/></shape></scene>", "parameter $missing has no <default>"),
@@ -464,4 +480,28 @@ fn a_sensor_may_reference_a_scene_level_sampler_and_film() {
         message.contains("test.xml:2: no <film> or <sampler> with id \"nothing\""),
         "{message}"
     );
+}
+
+#[test]
+fn shapes_may_reference_an_area_emitter_declared_at_scene_level() {
+    // Mitsuba's own Cornell box declares its lamp after the shapes that reference it.
+    let scene = parse(
+        "<scene>
+         <bsdf type=\"diffuse\" id=\"white\"/>
+         <shape type=\"rectangle\"><ref id=\"white\"/><ref id=\"lamp\"/></shape>
+         <shape type=\"cube\"><ref id=\"white\"/></shape>
+         <emitter type=\"area\" id=\"lamp\"><rgb name=\"radiance\" value=\"4\"/></emitter>
+         </scene>",
+    )
+    .unwrap();
+    let lamp = scene.shapes[0].emitter.as_ref().expect("the lamp is attached");
+    assert_eq!(lamp.id.as_deref(), Some("lamp"));
+    assert_eq!(scene.shapes[0].bsdf, Some(0));
+    assert!(scene.shapes[1].emitter.is_none());
+    assert!(scene.emitters.is_empty(), "an area emitter is not a scene-level light");
+    let twice = error(
+        "<scene><emitter type=\"area\" id=\"lamp\"/>
+         <shape type=\"cube\"><ref id=\"lamp\"/>\n<emitter type=\"area\"/></shape></scene>",
+    );
+    assert!(twice.contains("test.xml:3: a shape can have only one area emitter"), "{twice}");
 }

@@ -4,7 +4,7 @@
 
 use super::{named_conductor, Material, Microfacet, MicrofacetKind, RoughPlastic, Scattering};
 use crate::error::InputError;
-use crate::scene::{Plugin, Property};
+use crate::scene::{ColourRole, Plugin, Property};
 use glam::Vec3;
 
 /// A `<bsdf>` being read, and where its warnings go.
@@ -50,19 +50,6 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
             "sample_visible",
         ],
         _ => &[],
-    }
-}
-
-/// A colour property given as rgb or a float, or `default`.
-fn rgb(plugin: &Plugin, name: &str, default: Vec3) -> Result<Vec3, String> {
-    match plugin.properties.get(name).map(|p| &p.value) {
-        None => Ok(default),
-        Some(Property::Rgb(c)) => Ok(Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32)),
-        Some(Property::Float(v)) => Ok(Vec3::splat(*v as f32)),
-        Some(other) => Err(format!(
-            "\"{name}\" must be an rgb or float, not a {}",
-            other.kind()
-        )),
     }
 }
 
@@ -226,16 +213,28 @@ impl BsdfReader<'_> {
         .material()
     }
 
-    /// A colour property: non-negative and finite, else `default` with a warning.
+    /// A colour property (a reflectance, or an unbounded quantity for `eta` and `k`):
+    /// non-negative and finite, else `default` with a warning.
     fn colour(&mut self, name: &str, default: Vec3) -> Vec3 {
-        match rgb(self.plugin, name, default) {
-            Ok(v) if v.is_finite() && v.min_element() >= 0.0 => v,
-            Ok(_) => {
-                self.warn("a colour is negative or not finite; using the default".into());
+        let role = match name {
+            "eta" | "k" => ColourRole::Unbounded,
+            _ => ColourRole::Reflectance,
+        };
+        match self.plugin.colour(name, role) {
+            Ok(v) => self.checked_colour(v.unwrap_or(default), default),
+            Err((_, message)) => {
+                self.warn(format!("{message}; using the default"));
                 default
             }
-            Err(message) => {
-                self.warn(format!("{message}; using the default"));
+        }
+    }
+
+    /// `value` if it is non-negative and finite, else `default` with a warning.
+    fn checked_colour(&mut self, value: Vec3, default: Vec3) -> Vec3 {
+        match value {
+            v if v.is_finite() && v.min_element() >= 0.0 => v,
+            _ => {
+                self.warn("a colour is negative or not finite; using the default".into());
                 default
             }
         }

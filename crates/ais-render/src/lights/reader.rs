@@ -5,7 +5,7 @@
 use super::{DeltaLight, Environment, EnvironmentMap, Spot};
 use crate::error::InputError;
 use crate::image_io::read_image;
-use crate::scene::{self, FileResolver, Plugin, Property};
+use crate::scene::{self, ColourRole, FileResolver, Plugin};
 use glam::{DMat3, DVec3, Vec3};
 use std::path::Path;
 
@@ -152,19 +152,11 @@ pub(crate) fn spectrum_property(
     plugin: &Plugin,
     name: &str,
 ) -> Result<Vec3, InputError> {
-    let value = match plugin.properties.get(name).map(|p| &p.value) {
-        Some(Property::Rgb(c)) => Vec3::new(c[0] as f32, c[1] as f32, c[2] as f32),
-        Some(Property::Float(v)) => Vec3::splat(*v as f32),
+    let value = plugin
+        .colour(name, ColourRole::Emission)
+        .map_err(|(line, message)| InputError::at(file, line, message))?
         // Mitsuba's default for every emitter.
-        None => Vec3::ONE,
-        Some(other) => {
-            return Err(InputError::at(
-                file,
-                plugin.line,
-                format!("{name} must be an rgb or float, not a {}", other.kind()),
-            ))
-        }
-    };
+        .unwrap_or(Vec3::ONE);
     if !value.is_finite() || value.min_element() < 0.0 {
         return Err(InputError::at(
             file,

@@ -166,7 +166,8 @@ pub struct SceneDescription {
     pub bsdfs: Vec<Plugin>,
     /// Top-level textures, which BSDFs reference by id.
     pub textures: Vec<Plugin>,
-    /// Top-level films and samplers, which a sensor references by id.
+    /// Top-level films and samplers, which a sensor references by id, and top-level area
+    /// emitters, which shapes reference by id.
     pub referable: Vec<Plugin>,
     /// Scene-level emitters (`envmap`, `constant`, …), carried for the lighting code.
     pub emitters: Vec<Plugin>,
@@ -264,6 +265,12 @@ fn collect_referenced(path: &Path, plugins: &[Plugin], scene: &mut SceneDescript
     };
     scene.textures = of(&["texture"]);
     scene.referable = of(&["film", "sampler"]);
+    scene.referable.extend(
+        plugins
+            .iter()
+            .filter(|p| p.tag == "emitter" && p.kind == "area" && p.id.is_some())
+            .cloned(),
+    );
 }
 
 /// One top-level element other than a BSDF (read before the rest).
@@ -281,11 +288,13 @@ fn read_top_level(
             let shape = read_shape(path, files, plugin, scene).map_err(at)?;
             scene.shapes.push(shape);
         }
+        // Shapes reference it by id.
+        "emitter" if plugin.kind == "area" && plugin.id.is_some() => {}
         "emitter" if plugin.kind == "area" => {
             return Err(InputError::at(
                 path,
                 plugin.line,
-                "an area emitter must be nested in a <shape>",
+                "an area emitter must be nested in a <shape> or have an id that shapes reference",
             ))
         }
         "emitter" => scene.emitters.push(plugin.clone()),
@@ -563,13 +572,29 @@ fn attachments(shape: &Plugin, scene: &mut SceneDescription) -> Result<Attachmen
         emitter: None,
     };
     for (_, id, line) in &shape.references {
-        let index = scene
+        let bsdf = scene
             .bsdfs
             .iter()
-            .position(|b| b.id.as_deref() == Some(id.as_str()))
-            .ok_or((*line, format!("no <bsdf> with id \"{id}\"")))?;
-        if attached.bsdf.replace(index).is_some() {
-            return Err((*line, "a shape can have only one bsdf".into()));
+            .position(|b| b.id.as_deref() == Some(id.as_str()));
+        let emitter = || {
+            scene
+                .referable
+                .iter()
+                .find(|p| p.tag == "emitter" && p.id.as_deref() == Some(id.as_str()))
+        };
+        if let Some(index) = bsdf {
+            if attached.bsdf.replace(index).is_some() {
+                return Err((*line, "a shape can have only one bsdf".into()));
+            }
+        } else if let Some(emitter) = emitter() {
+            if attached.emitter.replace(emitter.clone()).is_some() {
+                return Err((*line, "a shape can have only one area emitter".into()));
+            }
+        } else {
+            return Err((
+                *line,
+                format!("no <bsdf> or area <emitter> with id \"{id}\""),
+            ));
         }
     }
     for child in &shape.children {
@@ -580,7 +605,11 @@ fn attachments(shape: &Plugin, scene: &mut SceneDescription) -> Result<Attachmen
                     return Err((child.line, "a shape can have only one bsdf".into()));
                 }
             }
-            "emitter" if child.kind == "area" => attached.emitter = Some(child.clone()),
+            "emitter" if child.kind == "area" => {
+                if attached.emitter.replace(child.clone()).is_some() {
+                    return Err((child.line, "a shape can have only one area emitter".into()));
+                }
+            }
             "emitter" => {
                 return Err((
                     child.line,

@@ -1,8 +1,10 @@
 //! Scene files: the Mitsuba 3 XML subset we read, and the typed description built from it.
 
+mod cie1931;
 mod description;
 mod file_resolver;
 mod properties;
+mod spectrum;
 mod xml;
 
 pub(crate) use description::warn_unknown;
@@ -12,4 +14,5 @@ pub use description::{
 };
 pub use file_resolver::FileResolver;
 pub use properties::{LocatedProperty, Plugin, Property};
+pub use spectrum::{ColourRole, SampledSpectrum, Spectrum};
 pub use xml::look_at;

@@ -1,7 +1,8 @@
 //! Plugin descriptions as read from Mitsuba XML: a type, an id, named properties and nested
 //! plugins, before any interpretation.
 
-use glam::{DMat4, DVec3};
+use super::spectrum::{ColourRole, Spectrum};
+use glam::{DMat4, DVec3, Vec3};
 use std::collections::BTreeMap;
 
 /// One property value of a plugin.
@@ -17,6 +18,8 @@ pub enum Property {
     String(String),
     /// `<rgb>` (a single value is replicated).
     Rgb([f64; 3]),
+    /// `<spectrum>`: one value, or values at wavelengths.
+    Spectrum(Spectrum),
     /// `<point>`.
     Point(DVec3),
     /// `<vector>`.
@@ -34,6 +37,7 @@ impl Property {
             Property::Boolean(_) => "boolean",
             Property::String(_) => "string",
             Property::Rgb(_) => "rgb",
+            Property::Spectrum(_) => "spectrum",
             Property::Point(_) => "point",
             Property::Vector(_) => "vector",
             Property::Transform(_) => "transform",
@@ -147,6 +151,22 @@ impl Plugin {
             }) => Ok(*v),
             Some(p) => Err(self.wrong_kind(name, p, "point")),
         }
+    }
+
+    /// A colour property given as an rgb, a float or a spectrum, as linear sRGB for a
+    /// property of `role` (`None` when not given). Spectra become colours as Mitsuba's RGB
+    /// variants make them ([`Spectrum::to_rgb`]).
+    pub fn colour(&self, name: &str, role: ColourRole) -> Result<Option<Vec3>, (u32, String)> {
+        let Some(property) = self.properties.get(name) else {
+            return Ok(None);
+        };
+        let rgb = match &property.value {
+            Property::Rgb(c) => *c,
+            Property::Float(v) => [*v; 3],
+            Property::Spectrum(spectrum) => spectrum.to_rgb(role),
+            _ => return Err(self.wrong_kind(name, property, "rgb, float or spectrum")),
+        };
+        Ok(Some(Vec3::from_array(rgb.map(|c| c as f32))))
     }
 
     fn wrong_kind(&self, name: &str, property: &LocatedProperty, wanted: &str) -> (u32, String) {

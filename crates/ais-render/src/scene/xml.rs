@@ -2,6 +2,7 @@
 //! transforms. Interpretation of the plugins happens in [`super::description`].
 
 use super::properties::{LocatedProperty, Plugin, Property};
+use super::spectrum::{SampledSpectrum, Spectrum};
 use crate::error::InputError;
 use glam::{DMat4, DVec3};
 use std::collections::{BTreeMap, HashMap};
@@ -452,26 +453,24 @@ impl<'a> Reader<'a> {
         Ok(plugin)
     }
 
-    /// A `<spectrum>` as Mitsuba's RGB variants read it: one value is a uniform spectrum, the
-    /// same in every channel. Wavelength–value pairs and spectrum files need the colour
-    /// matching functions, which ais does not have yet: they are refused, with the way out.
+    /// A `<spectrum>`: one value (uniform), wavelength:value pairs, or a `.spd` file (found
+    /// next to the scene file that names it). Its colour is worked out by the plugin that
+    /// reads it, since that depends on what it describes ([`crate::scene::ColourRole`]).
     fn spectrum(&self, node: roxmltree::Node) -> Result<Property, InputError> {
-        if node.attribute("filename").is_some() {
-            return Err(self.error(
-                node,
-                "a <spectrum> read from a file is not supported by ais; give an <rgb>",
-            ));
+        if let Some(name) = self.optional_attribute(node, "filename")? {
+            let folder = self.file.parent().unwrap_or(Path::new("."));
+            let sampled = SampledSpectrum::read_file(&folder.join(name))
+                .map_err(|message| self.error(node, message))?;
+            return Ok(Property::Spectrum(Spectrum::Sampled(sampled)));
         }
         let text = self.attribute(node, "value")?;
         if text.contains(':') {
-            return Err(self.error(
-                node,
-                "a <spectrum> of wavelength:value pairs is not supported by ais yet; give one \
-                 value (a uniform spectrum) or an <rgb>",
-            ));
+            let sampled =
+                SampledSpectrum::parse_pairs(&text).map_err(|message| self.error(node, message))?;
+            return Ok(Property::Spectrum(Spectrum::Sampled(sampled)));
         }
         match self.numbers(node, &text)?.as_slice() {
-            [v] => Ok(Property::Rgb([*v; 3])),
+            [v] => Ok(Property::Spectrum(Spectrum::Uniform(*v))),
             _ => Err(self.error(
                 node,
                 format!("<spectrum> needs one value or wavelength:value pairs, got \"{text}\""),
