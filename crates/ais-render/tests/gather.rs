@@ -60,6 +60,35 @@ fn white_furnace() {
 }
 
 #[test]
+fn smooth_white_surfaces_reflect_a_furnace_exactly() {
+    // A perfect mirror reflects the constant environment; a white smooth plastic does too,
+    // its mirror lobe carrying F and its base 1 − F (the base's inner reflections lose
+    // nothing). Only BSDF samples see the mirror lobe: light samples bring nothing there.
+    for bsdf in [
+        r#"<bsdf type="conductor"/>"#,
+        r#"<bsdf type="plastic"><rgb name="diffuse_reflectance" value="1"/></bsdf>"#,
+    ] {
+        let xml = format!(
+            r#"<scene version="3.0.0">{}
+            <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
+            <shape type="sphere"><float name="radius" value="1"/>{bsdf}</shape></scene>"#,
+            common::camera("0, -5, 0", "0, 0, 0", 8.0, 8)
+        );
+        let world = common::scene_world("smooth-furnace", &xml, &[]);
+        for strategy in [Strategy::Bsdf, Strategy::Mis] {
+            for mode in MODES {
+                let statistics = pixel_statistics(&world, settings(strategy, mode, 16), 2, 8);
+                let (average, error) = statistics.image_mean();
+                assert!(
+                    (average - 1.0).abs() <= 4.0 * error + 2e-3,
+                    "{bsdf} {strategy:?} {mode:?}: {average} ± {error}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
 fn plane_under_a_sphere_light_matches_the_analytic_irradiance() {
     let (world, exact) = common::plane_under_a_sphere_light();
     for strategy in STRATEGIES {

@@ -7,7 +7,9 @@ mod common;
 use ais::mapping::LatLong;
 use ais::rng::Pcg32;
 use ais::testing::{ChiSquareTest, Drawn};
-use ais_render::bsdf::{Material, Microfacet, RoughPlastic, Scattering, ShadingFrame};
+use ais_render::bsdf::{
+    Dielectric, Material, Microfacet, RoughPlastic, Scattering, ShadingFrame, SmoothPlastic,
+};
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
 use ais_render::integrators::gather::{GatherPoint, Strategy};
@@ -465,6 +467,74 @@ fn rough_plastic_sampling_fits() {
             |d| material.pdf(&frame, wo, d),
         );
         assert!(p > SIGNIFICANCE, "view {seed}: p = {p}");
+    }
+}
+
+fn smooth_plastic(diffuse: Vec3) -> Material {
+    Material {
+        scattering: Scattering::Plastic(SmoothPlastic::new(1.5, diffuse, Vec3::ONE, false)),
+        two_sided: false,
+    }
+}
+
+#[test]
+fn smooth_plastic_base_sampling_fits() {
+    // Samples that pick the mirror lobe come back with density 0 and are missing mass,
+    // which the base's density accounts for: it integrates to 1 − P(mirror).
+    let material = smooth_plastic(Vec3::new(0.6, 0.3, 0.2));
+    for (seed, (frame, wo)) in views().into_iter().enumerate() {
+        let p = fit(
+            200_000,
+            50 + seed as u64,
+            |u| Some(material.sample(&frame, wo, u)).filter(|s| s.1 > 0.0),
+            |d| material.pdf(&frame, wo, d),
+        );
+        assert!(p > SIGNIFICANCE, "view {seed}: p = {p}");
+    }
+}
+
+#[test]
+fn smooth_bsdfs_do_not_create_energy_and_white_ones_keep_it() {
+    // Albedo = E[mass / probability] over specular picks + E[f cos / p] over the base.
+    let glass = |thin| Material {
+        scattering: Scattering::Dielectric(Dielectric {
+            eta: 1.5,
+            reflectance: Vec3::ONE,
+            transmittance: Vec3::ONE,
+            thin,
+        }),
+        two_sided: false,
+    };
+    let mut rng = Pcg32::new(41, 1);
+    for (material, lowest) in [
+        (smooth_plastic(Vec3::ONE), 0.3),
+        (smooth_plastic(Vec3::splat(0.5)), 0.2),
+        // A thin sheet and the outside of glass (transmission scaled by 1/η²).
+        (glass(true), 0.999),
+        (glass(false), 0.44),
+    ] {
+        for (frame, wo) in views() {
+            let n = 100_000;
+            let mut sum = 0.0;
+            for _ in 0..n {
+                let u = [rng.next_f32(), rng.next_f32()];
+                let Some(sample) = material.sample_lobe(&frame, wo, u) else {
+                    continue;
+                };
+                sum += match sample.specular {
+                    Some(mass) => (mass.weight.x / mass.probability) as f64,
+                    None => {
+                        let pdf = material.pdf(&frame, wo, sample.direction);
+                        material.eval(&frame, wo, sample.direction).x as f64 / pdf
+                    }
+                };
+            }
+            let albedo = sum / n as f64;
+            assert!(
+                albedo <= 1.001 && albedo > lowest,
+                "{material:?}: albedo {albedo}"
+            );
+        }
     }
 }
 

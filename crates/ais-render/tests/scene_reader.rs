@@ -494,14 +494,23 @@ fn shapes_may_reference_an_area_emitter_declared_at_scene_level() {
          </scene>",
     )
     .unwrap();
-    let lamp = scene.shapes[0].emitter.as_ref().expect("the lamp is attached");
+    let lamp = scene.shapes[0]
+        .emitter
+        .as_ref()
+        .expect("the lamp is attached");
     assert_eq!(lamp.id.as_deref(), Some("lamp"));
     assert_eq!(scene.shapes[0].bsdf, Some(0));
     assert!(scene.shapes[1].emitter.is_none());
-    assert!(scene.emitters.is_empty(), "an area emitter is not a scene-level light");
+    assert!(
+        scene.emitters.is_empty(),
+        "an area emitter is not a scene-level light"
+    );
     let twice = error(
         "<scene><emitter type=\"area\" id=\"lamp\"/>
          <shape type=\"cube\"><ref id=\"lamp\"/>\n<emitter type=\"area\"/></shape></scene>",
     );
-    assert!(twice.contains("test.xml:3: a shape can have only one area emitter"), "{twice}");
+    assert!(
+        twice.contains("test.xml:3: a shape can have only one area emitter"),
+        "{twice}"
+    );
 }

@@ -124,15 +124,13 @@ impl Draw<'_> {
         let strategy = self.settings.strategy;
         let mut toward = strategy.sample_direction(at, u)?;
         let pdf = strategy.pdf(at, &mut toward);
-        let direction = toward.direction;
-        if pdf <= 0.0 || !at.material.in_support(&at.frame, at.wo, direction) {
+        if pdf <= 0.0 || !at.carries(&toward) {
             return None;
         }
         let mut test = RayCounts::default();
         let actual = arriving_light(self.world, at, &mut toward, &mut test);
         self.stats.free_tests += test.occlusion;
-        (actual != Vec3::ZERO)
-            .then(|| at.material.eval(&at.frame, at.wo, direction) * actual / pdf as f32)
+        (actual != Vec3::ZERO).then(|| at.scattering(&toward) * actual / pdf as f32)
     }
 
     /// The candidate count for about `rays` candidates that bring light, from a pilot of

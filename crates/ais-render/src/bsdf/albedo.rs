@@ -27,7 +27,7 @@ pub struct TextureScene<'a> {
 pub(super) fn albedo_parameter(kind: &str) -> Option<&'static str> {
     match kind {
         "diffuse" => Some("reflectance"),
-        "roughplastic" => Some("diffuse_reflectance"),
+        "roughplastic" | "plastic" => Some("diffuse_reflectance"),
         _ => None,
     }
 }
@@ -92,7 +92,10 @@ impl Material {
         match &mut material.scattering {
             super::Scattering::Diffuse { reflectance } => *reflectance = albedo,
             super::Scattering::RoughPlastic(plastic) => *plastic = plastic.with_diffuse(albedo),
-            super::Scattering::RoughConductor { .. } => {}
+            super::Scattering::Plastic(plastic) => *plastic = plastic.with_diffuse(albedo),
+            super::Scattering::RoughConductor { .. }
+            | super::Scattering::Conductor { .. }
+            | super::Scattering::Dielectric(_) => {}
         }
         material
     }

@@ -1,16 +1,19 @@
 //! BSDFs: Mitsuba's `diffuse`, `roughconductor` and `roughplastic` (GGX, visible-normal
-//! sampling) and the `twosided` adapter, each evaluating as Mitsuba 3 does.
+//! sampling), the smooth `conductor`, `plastic`, `dielectric` and `thindielectric`, and the
+//! `twosided` adapter, each evaluating as Mitsuba 3 does.
 
 mod albedo;
 mod conductors;
 mod microfacet;
 mod reader;
 mod rough_plastic;
+mod specular;
 
 pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
 pub use rough_plastic::RoughPlastic;
+pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
 
 use crate::geometry::basis;
 use crate::scene::Plugin;
@@ -39,6 +42,37 @@ pub enum Scattering {
     },
     /// Mitsuba's `roughplastic`: a GGX dielectric coating over a Lambertian base.
     RoughPlastic(RoughPlastic),
+    /// Mitsuba's `conductor`: a smooth mirror (a specular lobe only).
+    Conductor {
+        /// Real part of the complex index of refraction.
+        eta: Vec3,
+        /// Imaginary part; `eta = k = 0` stands for `material = "none"` (F = 1).
+        k: Vec3,
+        /// Multiplier of the reflectance.
+        specular: Vec3,
+    },
+    /// Mitsuba's `plastic`: a smooth coating (a specular lobe) over a Lambertian base.
+    Plastic(SmoothPlastic),
+    /// Mitsuba's `dielectric` and `thindielectric` (specular lobes only).
+    Dielectric(Dielectric),
+}
+
+/// A direction drawn from a BSDF.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BsdfSample {
+    /// The direction (world space, unit).
+    pub direction: Vec3,
+    /// When a specular lobe was picked: its mass and the probability of picking it.
+    pub specular: Option<SpecularMass>,
+}
+
+/// A specular lobe picked by a BSDF sample: a point mass over directions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpecularMass {
+    /// What the lobe multiplies the radiance arriving along it by (cosine included).
+    pub weight: Vec3,
+    /// The probability that the BSDF sample picked it.
+    pub probability: f32,
 }
 
 /// A surface's scattering and sidedness.
@@ -136,10 +170,14 @@ impl Material {
         .material()
     }
 
-    /// Whether `wi` can carry light to `wo`: both on the front side of the shading and
-    /// geometric normals (the support of these reflection-only BSDFs).
+    /// Whether `wi` can carry light to `wo` through the BSDF's continuous part: both on the
+    /// front side of the shading and geometric normals. Smooth conductors and dielectrics
+    /// have no continuous part: only their specular lobes ([`Material::sample_lobe`]) carry.
     pub fn in_support(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> bool {
-        frame.normal.dot(wo) > 0.0
+        !matches!(
+            self.scattering,
+            Scattering::Conductor { .. } | Scattering::Dielectric(_)
+        ) && frame.normal.dot(wo) > 0.0
             && frame.normal.dot(wi) > 0.0
             && frame.geometric.dot(wi) > 0.0
             && frame.geometric.dot(wo) > 0.0
@@ -168,30 +206,58 @@ impl Material {
                 specular * fresnel * (microfacet.d(h) * microfacet.g(i, o, h) / (4.0 * o.z))
             }
             Scattering::RoughPlastic(ref plastic) => plastic.eval(o, i),
+            Scattering::Plastic(ref plastic) => plastic.eval(o, i),
+            // No continuous part (outside the support).
+            Scattering::Conductor { .. } | Scattering::Dielectric(_) => Vec3::ZERO,
         }
     }
 
-    /// A direction drawn from the BSDF for viewing direction `wo`, and its density.
+    /// A direction drawn from the BSDF's continuous part for viewing direction `wo`, and its
+    /// density; a sample that picks a specular lobe comes back with density 0 (see
+    /// [`Material::sample_lobe`]).
     pub fn sample(&self, frame: &ShadingFrame, wo: Vec3, u: [f32; 2]) -> (Vec3, f64) {
+        match self.sample_lobe(frame, wo, u) {
+            Some(BsdfSample {
+                direction,
+                specular: None,
+            }) => (direction, self.pdf(frame, wo, direction)),
+            _ => (frame.normal, 0.0),
+        }
+    }
+
+    /// A direction drawn from the BSDF for viewing direction `wo`: from its continuous part,
+    /// or a specular lobe with its mass (`None`: nothing scatters toward `wo`).
+    pub fn sample_lobe(&self, frame: &ShadingFrame, wo: Vec3, u: [f32; 2]) -> Option<BsdfSample> {
         let o = frame.to_local(wo);
         let reflect = |h: Vec3| 2.0 * o.dot(h) * h - o;
         let local = match self.scattering {
-            Scattering::Diffuse { .. } => cosine_hemisphere(u),
-            Scattering::RoughConductor { microfacet, .. } => {
-                if o.z <= 0.0 {
-                    return (frame.normal, 0.0);
-                }
-                reflect(microfacet.sample(o, u))
-            }
+            Scattering::Diffuse { .. } => specular::LobeSample::Continuous(cosine_hemisphere(u)),
+            Scattering::RoughConductor { microfacet, .. } => (o.z > 0.0)
+                .then(|| specular::LobeSample::Continuous(reflect(microfacet.sample(o, u))))?,
             Scattering::RoughPlastic(ref plastic) => {
-                if o.z <= 0.0 {
-                    return (frame.normal, 0.0);
-                }
-                plastic.sample(o, u)
+                (o.z > 0.0).then(|| specular::LobeSample::Continuous(plastic.sample(o, u)))?
+            }
+            Scattering::Plastic(ref plastic) => plastic.sample(o, u)?,
+            Scattering::Conductor { eta, k, specular } => {
+                specular::LobeSample::Specular(specular::conductor_lobe(o, eta, k, specular)?)
+            }
+            Scattering::Dielectric(dielectric) => {
+                specular::LobeSample::Specular(dielectric.sample(o, u[0])?)
             }
         };
-        let wi = frame.to_world(local).normalize();
-        (wi, self.pdf(frame, wo, wi))
+        Some(match local {
+            specular::LobeSample::Continuous(local) => BsdfSample {
+                direction: frame.to_world(local).normalize(),
+                specular: None,
+            },
+            specular::LobeSample::Specular(lobe) => BsdfSample {
+                direction: frame.to_world(lobe.local).normalize(),
+                specular: Some(SpecularMass {
+                    weight: lobe.weight,
+                    probability: lobe.probability,
+                }),
+            },
+        })
     }
 
     /// Density of [`Material::sample`] at `wi`.
@@ -222,6 +288,14 @@ impl Material {
                 }
                 plastic.pdf(o, i, reflection_pdf(plastic.microfacet))
             }
+            Scattering::Plastic(ref plastic) => {
+                if o.z <= 0.0 {
+                    return 0.0;
+                }
+                plastic.pdf(o, i)
+            }
+            // Point masses only: no density over directions.
+            Scattering::Conductor { .. } | Scattering::Dielectric(_) => 0.0,
         }) as f64
     }
 }
@@ -286,14 +360,14 @@ mod tests {
     #[test]
     fn unsupported_bsdfs_and_properties_warn() {
         let (m, warnings) = materials(
-            r#"<bsdf type="dielectric" id="a"/>
+            r#"<bsdf type="measured" id="a"/>
                <bsdf type="roughconductor" id="b"><string name="material" value="Unobtainium"/><float name="alpha_u" value="0.1"/></bsdf>
                <bsdf type="roughplastic" id="c"><string name="int_ior" value="kryptonite"/></bsdf>"#,
         );
         assert_eq!(m[0], Material::default());
         let all = warnings.join("\n");
         assert!(
-            all.contains("m.xml:1: bsdf \"dielectric\" is not implemented"),
+            all.contains("m.xml:1: bsdf \"measured\" is not implemented"),
             "{all}"
         );
         assert!(

@@ -2,7 +2,10 @@
 //! unsupported replaced by the closest supported value with a warning naming the file and
 //! line.
 
-use super::{named_conductor, Material, Microfacet, MicrofacetKind, RoughPlastic, Scattering};
+use super::{
+    named_conductor, Dielectric, Material, Microfacet, MicrofacetKind, RoughPlastic, Scattering,
+    SmoothPlastic,
+};
 use crate::error::InputError;
 use crate::scene::{ColourRole, Plugin, Property};
 use glam::Vec3;
@@ -21,6 +24,9 @@ pub(super) struct BsdfReader<'a> {
     pub depth: usize,
 }
 
+/// Mitsuba's default exterior index of refraction (air).
+const AIR: f64 = 1.000277;
+
 /// The deepest a BSDF may be nested in others, references included: deeper is a cycle.
 const DEEPEST_BSDF: usize = 16;
 
@@ -38,6 +44,20 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
             "k",
             "specular_reflectance",
             "sample_visible",
+        ],
+        "conductor" => &["material", "eta", "k", "specular_reflectance"],
+        "plastic" => &[
+            "int_ior",
+            "ext_ior",
+            "diffuse_reflectance",
+            "specular_reflectance",
+            "nonlinear",
+        ],
+        "dielectric" | "thindielectric" => &[
+            "int_ior",
+            "ext_ior",
+            "specular_reflectance",
+            "specular_transmittance",
         ],
         "roughplastic" => &[
             "distribution",
@@ -144,6 +164,10 @@ impl BsdfReader<'_> {
             }
             "roughconductor" => self.rough_conductor(),
             "roughplastic" => self.rough_plastic(),
+            "conductor" => self.smooth_conductor(),
+            "plastic" => self.smooth_plastic(),
+            "dielectric" => self.dielectric(false),
+            "thindielectric" => self.dielectric(true),
             "twosided" => Material {
                 two_sided: true,
                 ..self.nested()?
@@ -160,10 +184,7 @@ impl BsdfReader<'_> {
     /// Warns of the properties and nested elements this BSDF does not read.
     fn warn_ignored(&mut self) {
         let plugin = self.plugin;
-        if matches!(
-            plugin.kind.as_str(),
-            "diffuse" | "roughconductor" | "roughplastic"
-        ) {
+        if !known_properties(&plugin.kind).is_empty() {
             let known = known_properties(&plugin.kind);
             crate::scene::warn_unknown(self.file, plugin, known, self.warnings);
         }
@@ -312,22 +333,10 @@ impl BsdfReader<'_> {
 
     fn rough_plastic(&mut self) -> Material {
         let microfacet = self.microfacet();
-        let plugin = self.plugin;
-        let mut warn = |message: String| self.warn(message);
-        let int_ior = index_of_refraction(plugin, "int_ior", 1.49, &mut warn);
-        let ext_ior = index_of_refraction(plugin, "ext_ior", 1.000277, &mut warn);
+        let eta = self.relative_ior(1.49);
         let diffuse = self.colour("diffuse_reflectance", Vec3::splat(0.5));
         let specular = self.colour("specular_reflectance", Vec3::ONE);
-        let nonlinear = plugin.boolean("nonlinear", false).unwrap_or(false);
-        let eta = (int_ior / ext_ior) as f32;
-        let eta = if eta.is_finite() && eta > 0.0 && eta != 1.0 {
-            eta
-        } else {
-            self.warn(format!(
-                "int_ior / ext_ior = {eta} must be positive and not 1; using 1.49"
-            ));
-            1.49
-        };
+        let nonlinear = self.plugin.boolean("nonlinear", false).unwrap_or(false);
         Material {
             scattering: Scattering::RoughPlastic(RoughPlastic::new(
                 microfacet,
@@ -338,5 +347,63 @@ impl BsdfReader<'_> {
             )),
             two_sided: false,
         }
+    }
+
+    fn smooth_conductor(&mut self) -> Material {
+        let (eta, k) = self.conductor_ior();
+        let specular = self.colour("specular_reflectance", Vec3::ONE);
+        Material {
+            scattering: Scattering::Conductor { eta, k, specular },
+            two_sided: false,
+        }
+    }
+
+    fn smooth_plastic(&mut self) -> Material {
+        let eta = self.relative_ior(1.49);
+        let diffuse = self.colour("diffuse_reflectance", Vec3::splat(0.5));
+        let specular = self.colour("specular_reflectance", Vec3::ONE);
+        let nonlinear = self.plugin.boolean("nonlinear", false).unwrap_or(false);
+        Material {
+            scattering: Scattering::Plastic(SmoothPlastic::new(
+                eta,
+                diffuse.min(Vec3::ONE),
+                specular,
+                nonlinear,
+            )),
+            two_sided: false,
+        }
+    }
+
+    /// `dielectric` (Mitsuba's default interior: BK7 glass) or `thindielectric`; both
+    /// scatter from either side.
+    fn dielectric(&mut self, thin: bool) -> Material {
+        let eta = self.relative_ior(1.5046);
+        Material {
+            scattering: Scattering::Dielectric(Dielectric {
+                eta,
+                reflectance: self.colour("specular_reflectance", Vec3::ONE),
+                transmittance: self.colour("specular_transmittance", Vec3::ONE),
+                thin,
+            }),
+            two_sided: false,
+        }
+    }
+
+    /// `int_ior / ext_ior` (defaults `default_interior` and air), positive and not 1, else
+    /// the defaults' ratio with a warning.
+    fn relative_ior(&mut self, default_interior: f64) -> f32 {
+        let plugin = self.plugin;
+        let mut warn = |message: String| self.warn(message);
+        let int_ior = index_of_refraction(plugin, "int_ior", default_interior, &mut warn);
+        let ext_ior = index_of_refraction(plugin, "ext_ior", AIR, &mut warn);
+        let eta = (int_ior / ext_ior) as f32;
+        if eta.is_finite() && eta > 0.0 && eta != 1.0 {
+            return eta;
+        }
+        let fallback = (default_interior / AIR) as f32;
+        self.warn(format!(
+            "int_ior / ext_ior = {eta} must be positive and not 1; using {fallback}"
+        ));
+        fallback
     }
 }

@@ -46,7 +46,7 @@ pub struct RoughPlastic {
 }
 
 /// The share of samples the specular lobe gets: its mean reflectance over both lobes'.
-fn specular_weight(diffuse: Vec3, specular: Vec3) -> f32 {
+pub(super) fn specular_weight(diffuse: Vec3, specular: Vec3) -> f32 {
     let d_mean = (diffuse.x + diffuse.y + diffuse.z) / 3.0;
     let s_mean = (specular.x + specular.y + specular.z) / 3.0;
     if d_mean + s_mean > 0.0 {

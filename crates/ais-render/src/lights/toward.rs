@@ -9,6 +9,7 @@
 
 use super::delta::DeltaArrival;
 use super::environment::{EnvironmentMap, MapLocation};
+use crate::bsdf::SpecularMass;
 use glam::Vec3;
 
 /// What a candidate direction meets first among the emitters.
@@ -48,6 +49,9 @@ pub struct Toward {
     on_map: Option<MapLocation>,
     /// What it meets first among the emitters, once known.
     pub(super) source: Source,
+    /// When a smooth surface's specular lobe gave it: the lobe's mass and the probability
+    /// of picking it (a point mass of BSDF sampling).
+    pub specular: Option<SpecularMass>,
 }
 
 impl Toward {
@@ -58,6 +62,16 @@ impl Toward {
             direction,
             on_map: None,
             source: Source::Unknown,
+            specular: None,
+        }
+    }
+
+    /// The direction of a specular lobe picked by a BSDF sample.
+    #[inline]
+    pub fn specular(direction: Vec3, mass: SpecularMass) -> Self {
+        Toward {
+            specular: Some(mass),
+            ..Toward::new(direction)
         }
     }
 
@@ -68,6 +82,7 @@ impl Toward {
             direction,
             on_map: location,
             source: Source::Environment,
+            specular: None,
         }
     }
 
@@ -78,6 +93,7 @@ impl Toward {
             direction,
             on_map: None,
             source: Source::Area(point),
+            specular: None,
         }
     }
 
@@ -88,6 +104,7 @@ impl Toward {
             direction: arrival.direction,
             on_map: None,
             source: Source::Delta(index, arrival),
+            specular: None,
         }
     }
 
@@ -96,6 +113,13 @@ impl Toward {
     #[inline]
     pub fn is_delta(&self) -> bool {
         matches!(self.source, Source::Delta(..))
+    }
+
+    /// Whether its probability is a point mass: drawn toward a delta light, or along a
+    /// specular lobe. No density (BSDF, light, guide) adds to it.
+    #[inline]
+    pub fn is_point_mass(&self) -> bool {
+        self.is_delta() || self.specular.is_some()
     }
 
     /// Its place on `map` (a scene has one environment), located on first use.

@@ -98,7 +98,7 @@ pub fn run_batch<P: BatchProbe>(
             continue;
         };
         let direction = toward.direction;
-        let in_support = at.material.in_support(&at.frame, at.wo, direction);
+        let in_support = at.carries(&toward);
         probe.decided(direction, in_support);
         let (decision, known) = decide(run, batch, &mut values, &mut toward, in_support);
         if let Decision::Trace { .. } = decision {
@@ -139,6 +139,11 @@ fn decide(
 ) -> (Decision, Option<Known>) {
     let acceptance = run.settings.acceptance;
     let direction = toward.direction;
+    if toward.specular.is_some() {
+        // A specular lobe is one direction whatever the map learned of its neighbours: it
+        // is always traced.
+        return (batch.decide_with(direction, in_support, |_| 1.0), None);
+    }
     if let Some(field) = &run.field {
         // Visibility alone: computing each candidate's value before deciding (to always
         // trace the bright ones) cost more time than it saved, measured on the rooms.
@@ -173,8 +178,7 @@ fn unoccluded_value(run: &BatchRun, toward: &mut Toward) -> (f32, Known) {
     let density = run.sampler.pdf(at, toward);
     let leaving = Leaving::new(run.world, at, toward);
     let value = if density > 0.0 {
-        luminance(at.material.eval(&at.frame, at.wo, toward.direction) * leaving.unoccluded)
-            / density as f32
+        luminance(at.scattering(toward) * leaving.unoccluded) / density as f32
     } else {
         0.0
     };
@@ -204,7 +208,6 @@ fn trace(
     counts: &mut RayCounts,
 ) -> (Vec3, Seen) {
     let at = run.at;
-    let direction = toward.direction;
     let Known {
         density: pdf,
         leaving,
@@ -222,7 +225,7 @@ fn trace(
     }
     let traced = leaving.unoccluded != Vec3::ZERO;
     let actual = leaving.trace(run.world, counts);
-    let value = at.material.eval(&at.frame, at.wo, direction) * actual / pdf as f32;
+    let value = at.scattering(&toward) * actual / pdf as f32;
     let seen = Seen {
         rating: rating(luminance(actual), luminance(leaving.unoccluded)),
         traced,

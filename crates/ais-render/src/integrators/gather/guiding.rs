@@ -79,7 +79,7 @@ impl<'a> CandidateSampler<'a> {
         match self.guide {
             None => p,
             // A point mass of the strategy: the guide's density does not add to it.
-            Some(_) if toward.is_delta() => (1.0 - self.fraction as f64) * p,
+            Some(_) if toward.is_point_mass() => (1.0 - self.fraction as f64) * p,
             Some(guide) => {
                 let alpha = self.fraction as f64;
                 (1.0 - alpha) * p + alpha * guide.pdf(toward.direction) as f64

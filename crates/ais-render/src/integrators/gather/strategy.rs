@@ -82,6 +82,38 @@ pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a
     }
 }
 
+impl GatherPoint<'_> {
+    /// Whether light arriving along `toward` can reach the viewer: a specular lobe's
+    /// direction always can, any other only inside the BSDF's continuous support.
+    #[inline]
+    pub fn carries(&self, toward: &Toward) -> bool {
+        toward.specular.is_some()
+            || self
+                .material
+                .in_support(&self.frame, self.wo, toward.direction)
+    }
+
+    /// What the surface multiplies the radiance arriving along `toward` by: a specular
+    /// lobe's mass, or the BSDF times the cosine.
+    #[inline]
+    pub fn scattering(&self, toward: &Toward) -> Vec3 {
+        match toward.specular {
+            Some(mass) => mass.weight,
+            None => self.material.eval(&self.frame, self.wo, toward.direction),
+        }
+    }
+
+    /// A direction drawn from the BSDF (`None`: nothing scatters toward the viewer).
+    #[inline]
+    fn sample_bsdf(&self, u: [f32; 2]) -> Option<Toward> {
+        let sample = self.material.sample_lobe(&self.frame, self.wo, u)?;
+        Some(match sample.specular {
+            Some(mass) => Toward::specular(sample.direction, mass),
+            None => Toward::new(sample.direction),
+        })
+    }
+}
+
 impl Strategy {
     /// The strategy actually usable at a point: light-based ones fall back to BSDF sampling
     /// in a scene without emitters.
@@ -129,16 +161,12 @@ impl Strategy {
     pub fn sample_direction(self, at: &GatherPoint, u: [f32; 2]) -> Option<Toward> {
         match self.effective(at) {
             Strategy::Uniform => Some(Toward::new(uniform_sphere(u))),
-            Strategy::Bsdf => {
-                let (direction, pdf) = at.material.sample(&at.frame, at.wo, u);
-                (pdf > 0.0).then_some(Toward::new(direction))
-            }
+            Strategy::Bsdf => at.sample_bsdf(u),
             Strategy::Light => at.lights.sample_toward(&at.receiver, u),
             Strategy::Mis => {
                 let w = MIS_BSDF_WEIGHT as f32;
                 if u[0] < w {
-                    let (direction, _) = at.material.sample(&at.frame, at.wo, [u[0] / w, u[1]]);
-                    Some(Toward::new(direction))
+                    at.sample_bsdf([u[0] / w, u[1]])
                 } else {
                     let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
                     at.lights.sample_toward(&at.receiver, [u0, u[1]])
@@ -149,10 +177,18 @@ impl Strategy {
 
     /// The density that weighs a candidate: the strategy's density of drawing what the
     /// direction meets first ([`crate::lights::Lights::pdf_toward`]); toward a delta light,
-    /// the probability of drawing that light (a point mass).
+    /// the probability of drawing that light, and along a specular lobe, the probability of
+    /// picking it (point masses, which no density adds to).
     #[inline]
     pub fn pdf(self, at: &GatherPoint, toward: &mut Toward) -> f64 {
         let light = |toward: &mut Toward| at.lights.pdf_toward(&at.receiver, toward);
+        if let Some(mass) = toward.specular {
+            let share = match self.effective(at) {
+                Strategy::Mis => MIS_BSDF_WEIGHT,
+                _ => 1.0,
+            };
+            return share * mass.probability as f64;
+        }
         match self.effective(at) {
             Strategy::Uniform => 1.0 / (4.0 * PI),
             Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, toward.direction),
