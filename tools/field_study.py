@@ -5,6 +5,9 @@
     python3 tools/crosscheck.py --setup          # makes .venv (Mitsuba reads the EXRs)
     SEEDS=5 .venv/bin/python tools/field_study.py 80x60 sunlit_room,interior off,auto 16,128
 
+A configuration is an `--ais` preset, optionally followed by flags after `+`
+(`auto+--cost-ratio=2`).
+
 For each scene of scenes/ (names without .xml), a reference is rendered once by ais with AIS
 off at 1024 spp and 16 rays (cached in target/field-study/). Then every configuration renders
 SEEDS times (default 8) at `--spp` 32 for n = 16 and 8 for n = 128, in one process, and the
@@ -25,15 +28,19 @@ import numpy as np
 
 mi.set_variant('scalar_rgb')
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-AIS = os.path.join(ROOT, 'target', 'release', 'ais')
+# AIS_BINARY picks another build (to compare two versions of the renderer).
+AIS = os.environ.get('AIS_BINARY', os.path.join(ROOT, 'target', 'release', 'ais'))
 WORK = os.path.join(ROOT, 'target', 'field-study')
 SPP_FOR = {16: 32, 128: 8}
 
 
-def render(scene, size, spp, rays, ais, seed, out):
+def render(scene, size, spp, rays, config, seed, out):
+    """Renders one configuration: an `--ais` preset, then extra flags after `+`
+    (`auto+--cost-ratio=2`)."""
+    ais, *flags = config.split('+')
     command = [AIS, 'render', os.path.join(ROOT, 'scenes', scene + '.xml'), '--resolution', size,
                '--spp', str(spp), '--rays', str(rays), '--ais', ais, '--seed', str(seed),
-               '--no-preview', '-o', out]
+               '--no-preview', '-o', out, *flags]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode:
         sys.exit(done.stderr)
@@ -63,7 +70,7 @@ def main():
             for config in configs:
                 errors, times, counts = [], [], ()
                 for seed in range(seeds):
-                    out = os.path.join(WORK, f'{scene}-{config}.exr')
+                    out = os.path.join(WORK, f'{scene}-{config.split("+")[0]}.exr')
                     image, seconds, counts = render(scene, size, SPP_FOR[n], n, config, seed, out)
                     errors.append(rel_mse(image, reference))
                     times.append(seconds)

@@ -49,11 +49,12 @@ pub const WELL_KNOWN: u32 = 512;
 /// See [`WELL_KNOWN`].
 pub const WELL_KNOWN_RECORD_ONE_IN: u64 = 4;
 
-/// Timings of sampled gathers: whole gathers, and the part spent on accepted candidates
-/// (density, unoccluded radiance, the occlusion ray, the BSDF, recording).
+/// Timings of sampled gathers: whole pixel samples from the camera ray on (what a gather
+/// costs besides its candidates is shared among them), and the part spent on accepted
+/// candidates (density, unoccluded radiance, the occlusion ray, the BSDF, recording).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct CostSample {
-    /// Time in the timed gathers.
+    /// Time in the timed gathers, from their camera rays on.
     pub gathers: Duration,
     /// Of which, time on accepted candidates.
     pub traced: Duration,
@@ -152,6 +153,17 @@ impl Learning for GatherLearning {
     }
 }
 
+/// Whether the tile's next field gather is one of the timed ones (one in
+/// [`TIMED_ONE_IN`], while learning with a measured cost ratio).
+pub(super) fn times_next_gather<P: BatchProbe>(
+    state: &GatherTile<P>,
+    settings: &GatherSettings,
+) -> bool {
+    state.observations.is_some()
+        && settings.cost_ratio.is_none()
+        && (state.gathers + 1).is_multiple_of(TIMED_ONE_IN)
+}
+
 /// Where a `map = field` gather happens.
 pub(super) struct FieldSite<'a> {
     /// Its cell of the field.
@@ -160,6 +172,9 @@ pub(super) struct FieldSite<'a> {
     at: &'a GatherPoint<'a>,
     /// The batch's scrambling seed.
     seed: u64,
+    /// When a timed gather's pixel sample began (its camera ray and shading point count
+    /// in what every candidate costs: they are paid once per n candidates).
+    pub started: Option<Instant>,
 }
 
 impl<'a> FieldSite<'a> {
@@ -180,6 +195,7 @@ impl<'a> FieldSite<'a> {
             ),
             at,
             seed,
+            started: None,
         }
     }
 }
@@ -233,9 +249,7 @@ pub(super) fn field_gather<P: BatchProbe>(
     field_gathers[usize::from(cell.is_none())] += 1;
     *gathers += 1;
     let clock = Cell::new(Duration::ZERO);
-    let timed = observations.is_some()
-        && settings.cost_ratio.is_none()
-        && gathers.is_multiple_of(TIMED_ONE_IN);
+    let timed = site.started.is_some();
     let sampler = CandidateSampler::plain(settings.strategy);
     let run = BatchRun {
         world,
@@ -253,9 +267,8 @@ pub(super) fn field_gather<P: BatchProbe>(
         .as_mut()
         .filter(|_| record)
         .map(|observations| observations.cell_mut(site.key));
-    let started = timed.then(Instant::now);
     let value = run_batch(&run, batch, counts, probe, recorder.as_mut());
-    if let Some(started) = started {
+    if let Some(started) = site.started {
         let after = batch.stats();
         cost.add(CostSample {
             gathers: started.elapsed(),

@@ -268,6 +268,8 @@ pub fn gather<P: BatchProbe>(
     state: &mut GatherTile<P>,
     counts: &mut RayCounts,
 ) -> Vec3 {
+    let started = (settings.map == MapSource::Field && field::times_next_gather(state, settings))
+        .then(std::time::Instant::now);
     counts.closest_hit += 1;
     let Some(hit) = world.geometry.intersect(ray) else {
         if settings.hide_emitters {
@@ -289,7 +291,8 @@ pub fn gather<P: BatchProbe>(
     let footprint = world.camera.footprint(hit.t, world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if settings.map == MapSource::Field {
-        let site = field::FieldSite::new(&hit, &at, footprint, settings.field_cell, seed);
+        let mut site = field::FieldSite::new(&hit, &at, footprint, settings.field_cell, seed);
+        site.started = started;
         return emitted + field::field_gather(world, settings, &site, state, counts);
     }
     let site = MapSite {
