@@ -24,6 +24,18 @@ pub(super) struct BsdfReader<'a> {
     pub depth: usize,
 }
 
+/// The parameters of a plastic's coating and base.
+struct Coating {
+    /// Relative index, interior over exterior.
+    eta: f32,
+    /// Albedo of the base (at most 1).
+    diffuse: Vec3,
+    /// Multiplier of the coating's reflection.
+    specular: Vec3,
+    /// Mitsuba's `nonlinear`.
+    nonlinear: bool,
+}
+
 /// Mitsuba's default exterior index of refraction (air).
 const AIR: f64 = 1.000277;
 
@@ -333,19 +345,29 @@ impl BsdfReader<'_> {
 
     fn rough_plastic(&mut self) -> Material {
         let microfacet = self.microfacet();
-        let eta = self.relative_ior(1.49);
-        let diffuse = self.colour("diffuse_reflectance", Vec3::splat(0.5));
-        let specular = self.colour("specular_reflectance", Vec3::ONE);
-        let nonlinear = self.plugin.boolean("nonlinear", false).unwrap_or(false);
+        let coat = self.coating();
         Material {
             scattering: Scattering::RoughPlastic(RoughPlastic::new(
                 microfacet,
-                eta,
-                diffuse.min(Vec3::ONE),
-                specular,
-                nonlinear,
+                coat.eta,
+                coat.diffuse,
+                coat.specular,
+                coat.nonlinear,
             )),
             two_sided: false,
+        }
+    }
+
+    /// What Mitsuba's `plastic` and `roughplastic` share: the coating's index (default
+    /// polypropylene in air), the base's albedo, the coating's tint and `nonlinear`.
+    fn coating(&mut self) -> Coating {
+        Coating {
+            eta: self.relative_ior(1.49),
+            diffuse: self
+                .colour("diffuse_reflectance", Vec3::splat(0.5))
+                .min(Vec3::ONE),
+            specular: self.colour("specular_reflectance", Vec3::ONE),
+            nonlinear: self.plugin.boolean("nonlinear", false).unwrap_or(false),
         }
     }
 
@@ -359,16 +381,13 @@ impl BsdfReader<'_> {
     }
 
     fn smooth_plastic(&mut self) -> Material {
-        let eta = self.relative_ior(1.49);
-        let diffuse = self.colour("diffuse_reflectance", Vec3::splat(0.5));
-        let specular = self.colour("specular_reflectance", Vec3::ONE);
-        let nonlinear = self.plugin.boolean("nonlinear", false).unwrap_or(false);
+        let coat = self.coating();
         Material {
             scattering: Scattering::Plastic(SmoothPlastic::new(
-                eta,
-                diffuse.min(Vec3::ONE),
-                specular,
-                nonlinear,
+                coat.eta,
+                coat.diffuse,
+                coat.specular,
+                coat.nonlinear,
             )),
             two_sided: false,
         }
