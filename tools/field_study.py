@@ -8,7 +8,7 @@
 A configuration is an `--ais` preset, optionally followed by flags after `+`
 (`auto+--cost-ratio=2`).
 
-For each scene of scenes/ (names without .xml), a reference is rendered once by ais with AIS
+For each scene of scenes/ (names without .xml; `default` is the built-in scene), a reference is rendered once by ais with AIS
 off at 1024 spp and 16 rays (cached in target/field-study/). Then every configuration renders
 SEEDS times (default 8) at `--spp` 32 for n = 16 and 8 for n = 128, in one process, and the
 script prints per configuration the mean relMSE against the reference (relMSE = mean((x − r)²
@@ -38,7 +38,9 @@ def render(scene, size, spp, rays, config, seed, out):
     """Renders one configuration: an `--ais` preset, then extra flags after `+`
     (`auto+--cost-ratio=2`)."""
     ais, *flags = config.split('+')
-    command = [AIS, 'render', os.path.join(ROOT, 'scenes', scene + '.xml'), '--resolution', size,
+    # `default` is the built-in scene (409k triangles: expensive rays).
+    source = [] if scene == 'default' else [os.path.join(ROOT, 'scenes', scene + '.xml')]
+    command = [AIS, 'render', *source, '--resolution', size,
                '--spp', str(spp), '--rays', str(rays), '--ais', ais, '--seed', str(seed),
                '--no-preview', '-o', out, *flags]
     done = subprocess.run(command, capture_output=True, text=True)
