@@ -95,7 +95,8 @@ impl Material {
             super::Scattering::Plastic(plastic) => *plastic = plastic.with_diffuse(albedo),
             super::Scattering::RoughConductor { .. }
             | super::Scattering::Conductor { .. }
-            | super::Scattering::Dielectric(_) => {}
+            | super::Scattering::Dielectric(_)
+            | super::Scattering::RoughDielectric(_) => {}
         }
         material
     }

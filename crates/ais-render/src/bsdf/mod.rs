@@ -6,12 +6,14 @@ mod albedo;
 mod conductors;
 mod microfacet;
 mod reader;
+mod rough_dielectric;
 mod rough_plastic;
 mod specular;
 
 pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
+pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
 
@@ -55,6 +57,8 @@ pub enum Scattering {
     Plastic(SmoothPlastic),
     /// Mitsuba's `dielectric` and `thindielectric` (specular lobes only).
     Dielectric(Dielectric),
+    /// Mitsuba's `roughdielectric`: rough reflection and transmission, from either side.
+    RoughDielectric(RoughDielectric),
 }
 
 /// A direction drawn from a BSDF.
@@ -174,6 +178,11 @@ impl Material {
     /// front side of the shading and geometric normals. Smooth conductors and dielectrics
     /// have no continuous part: only their specular lobes ([`Material::sample_lobe`]) carry.
     pub fn in_support(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> bool {
+        if let Scattering::RoughDielectric(_) = self.scattering {
+            // Either side, where the shading and geometric normals agree on it.
+            let agrees = |w: Vec3| frame.normal.dot(w) * frame.geometric.dot(w) > 0.0;
+            return agrees(wo) && agrees(wi);
+        }
         !matches!(
             self.scattering,
             Scattering::Conductor { .. } | Scattering::Dielectric(_)
@@ -207,6 +216,7 @@ impl Material {
             }
             Scattering::RoughPlastic(ref plastic) => plastic.eval(o, i),
             Scattering::Plastic(ref plastic) => plastic.eval(o, i),
+            Scattering::RoughDielectric(ref rough) => rough.eval(o, i),
             // No continuous part (outside the support).
             Scattering::Conductor { .. } | Scattering::Dielectric(_) => Vec3::ZERO,
         }
@@ -238,6 +248,9 @@ impl Material {
                 (o.z > 0.0).then(|| specular::LobeSample::Continuous(plastic.sample(o, u)))?
             }
             Scattering::Plastic(ref plastic) => plastic.sample(o, u)?,
+            Scattering::RoughDielectric(ref rough) => {
+                specular::LobeSample::Continuous(rough.sample(o, u)?)
+            }
             Scattering::Conductor { eta, k, specular } => {
                 specular::LobeSample::Specular(specular::conductor_lobe(o, eta, k, specular)?)
             }
@@ -263,6 +276,9 @@ impl Material {
     /// Density of [`Material::sample`] at `wi`.
     pub fn pdf(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> f64 {
         let (o, i) = (frame.to_local(wo), frame.to_local(wi));
+        if let Scattering::RoughDielectric(ref rough) = self.scattering {
+            return rough.pdf(o, i) as f64;
+        }
         if i.z <= 0.0 {
             return 0.0;
         }
@@ -294,8 +310,11 @@ impl Material {
                 }
                 plastic.pdf(o, i)
             }
-            // Point masses only: no density over directions.
-            Scattering::Conductor { .. } | Scattering::Dielectric(_) => 0.0,
+            // Point masses only: no density over directions (the rough dielectric returned
+            // above).
+            Scattering::Conductor { .. }
+            | Scattering::Dielectric(_)
+            | Scattering::RoughDielectric(_) => 0.0,
         }) as f64
     }
 }

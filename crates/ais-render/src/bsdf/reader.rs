@@ -3,8 +3,8 @@
 //! line.
 
 use super::{
-    named_conductor, Dielectric, Material, Microfacet, MicrofacetKind, RoughPlastic, Scattering,
-    SmoothPlastic,
+    named_conductor, Dielectric, Material, Microfacet, MicrofacetKind, RoughDielectric,
+    RoughPlastic, Scattering, SmoothPlastic,
 };
 use crate::error::InputError;
 use crate::scene::{ColourRole, Plugin, Property};
@@ -64,6 +64,17 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
             "diffuse_reflectance",
             "specular_reflectance",
             "nonlinear",
+        ],
+        "roughdielectric" => &[
+            "distribution",
+            "alpha",
+            "alpha_u",
+            "alpha_v",
+            "int_ior",
+            "ext_ior",
+            "specular_reflectance",
+            "specular_transmittance",
+            "sample_visible",
         ],
         "dielectric" | "thindielectric" => &[
             "int_ior",
@@ -180,6 +191,7 @@ impl BsdfReader<'_> {
             "plastic" => self.smooth_plastic(),
             "dielectric" => self.dielectric(false),
             "thindielectric" => self.dielectric(true),
+            "roughdielectric" => self.rough_dielectric(),
             "twosided" => Material {
                 two_sided: true,
                 ..self.nested()?
@@ -403,6 +415,21 @@ impl BsdfReader<'_> {
                 reflectance: self.colour("specular_reflectance", Vec3::ONE),
                 transmittance: self.colour("specular_transmittance", Vec3::ONE),
                 thin,
+            }),
+            two_sided: false,
+        }
+    }
+
+    /// `roughdielectric` (Mitsuba's default interior: BK7 glass), seen from either side.
+    fn rough_dielectric(&mut self) -> Material {
+        let microfacet = self.microfacet();
+        let eta = self.relative_ior(1.5046);
+        Material {
+            scattering: Scattering::RoughDielectric(RoughDielectric {
+                microfacet,
+                eta,
+                reflectance: self.colour("specular_reflectance", Vec3::ONE),
+                transmittance: self.colour("specular_transmittance", Vec3::ONE),
             }),
             two_sided: false,
         }
