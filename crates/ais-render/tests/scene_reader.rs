@@ -1,5 +1,7 @@
 //! The Mitsuba XML reader on hand-written scenes, including every error path.
 
+mod common;
+
 use ais_render::scene::{parse_scene, FovAxis, Property, ShapeGeometry};
 use glam::{DMat4, DVec3};
 use std::path::Path;
@@ -513,4 +515,14 @@ fn shapes_may_reference_an_area_emitter_declared_at_scene_level() {
         twice.contains("test.xml:3: a shape can have only one area emitter"),
         "{twice}"
     );
+}
+
+#[test]
+fn a_spectrum_file_that_is_no_file_is_refused_before_it_is_read() {
+    let folder = common::scratch("spectrum-device");
+    let scene = folder.join("scene.xml");
+    std::fs::create_dir_all(folder.join("folder.spd")).unwrap();
+    let text = "<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" filename=\"folder.spd\"/></emitter></scene>";
+    let error = parse_scene(&scene, text, &[]).expect_err("a folder is no spectrum");
+    assert!(error.to_string().contains("not a regular file"), "{error}");
 }

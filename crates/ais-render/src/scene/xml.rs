@@ -6,7 +6,7 @@ use super::spectrum::{SampledSpectrum, Spectrum};
 use crate::error::InputError;
 use glam::{DMat4, DVec3};
 use std::collections::{BTreeMap, HashMap};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Tags that introduce a nested plugin.
 const PLUGIN_TAGS: &[&str] = &[
@@ -214,21 +214,7 @@ impl<'a> Reader<'a> {
                 format!("files include one another more than {DEEPEST_INCLUDE} deep: a cycle?"),
             ));
         }
-        let name = self.attribute(node, "filename")?;
-        let folder = |file: &Path| file.parent().unwrap_or(Path::new(".")).to_path_buf();
-        let beside = folder(self.file).join(&name);
-        let path = if beside.exists() {
-            beside
-        } else {
-            folder(self.top).join(&name)
-        };
-        if !path.exists() {
-            return Err(self.error(
-                node,
-                format!("the included file {} does not exist", path.display()),
-            ));
-        }
-        crate::error::check_input_file(&path, "included scene file")?;
+        let path = self.included_path(node)?;
         let text = std::fs::read_to_string(&path).map_err(|e| {
             self.error(
                 node,
@@ -262,6 +248,27 @@ impl<'a> Reader<'a> {
         }
         scene.paths.extend(inner.paths);
         Ok(())
+    }
+
+    /// The file an `<include>` names: beside this file, else beside the scene file the
+    /// reading started from; an error if neither exists or it cannot be read as input.
+    fn included_path(&self, node: roxmltree::Node) -> Result<PathBuf, InputError> {
+        let name = self.attribute(node, "filename")?;
+        let folder = |file: &Path| file.parent().unwrap_or(Path::new(".")).to_path_buf();
+        let beside = folder(self.file).join(&name);
+        let path = if beside.exists() {
+            beside
+        } else {
+            folder(self.top).join(&name)
+        };
+        if !path.exists() {
+            return Err(self.error(
+                node,
+                format!("the included file {} does not exist", path.display()),
+            ));
+        }
+        crate::error::check_input_file(&path, "included scene file")?;
+        Ok(path)
     }
 
     /// Reads the `<default>`s, wherever they are, so that they apply to the whole file;
@@ -458,9 +465,13 @@ impl<'a> Reader<'a> {
     /// reads it, since that depends on what it describes ([`crate::scene::ColourRole`]).
     fn spectrum(&self, node: roxmltree::Node) -> Result<Property, InputError> {
         if let Some(name) = self.optional_attribute(node, "filename")? {
-            let folder = self.file.parent().unwrap_or(Path::new("."));
-            let sampled = SampledSpectrum::read_file(&folder.join(name))
-                .map_err(|message| self.error(node, message))?;
+            let path = self.file.parent().unwrap_or(Path::new(".")).join(name);
+            // A device or a folder would be read until memory runs out.
+            if path.exists() {
+                crate::error::check_input_file(&path, "spectrum file")?;
+            }
+            let sampled =
+                SampledSpectrum::read_file(&path).map_err(|message| self.error(node, message))?;
             return Ok(Property::Spectrum(Spectrum::Sampled(sampled)));
         }
         let text = self.attribute(node, "value")?;
