@@ -124,9 +124,36 @@ def mitsuba_scene_text(text, width, height, samples):
 DELTA_EMITTER = re.compile(r'<emitter\s+type="(point|spot|directional)"')
 
 
+INCLUDE = re.compile(r'<include\s+filename="([^"]+)"\s*/>')
+
+
+def inline_includes(text, folder, top_folder, depth=0):
+    """The scene text with every <include> replaced by the included file's elements (looked
+    for beside the including file, then beside the top scene, as both renderers do), so that
+    the integrator and film settings below reach elements that live in included files."""
+    if depth > 16:
+        fail_setup("scene files include one another more than 16 deep")
+
+    def replace(match):
+        path = os.path.join(folder, match.group(1))
+        if not os.path.exists(path):
+            path = os.path.join(top_folder, match.group(1))
+        with open(path) as f:
+            inner = f.read()
+        inner = re.sub(r"<\?xml[^>]*\?>", "", inner)
+        inner = re.sub(r"<scene\b[^>]*>", "", inner, count=1)
+        inner = re.sub(r"</scene>\s*$", "", inner.strip())
+        return inline_includes(inner, os.path.dirname(path), top_folder, depth + 1)
+
+    return INCLUDE.sub(replace, text)
+
+
 def render_mitsuba(scene, width, height, runs, spp, samples, work):
     with open(scene) as f:
         text = f.read()
+    folder = os.path.dirname(os.path.abspath(scene))
+    # Without comments, so that a commented-out element is not taken for the real one.
+    text = re.sub(r"<!--.*?-->", "", inline_includes(text, folder, folder), flags=re.S)
     if DELTA_EMITTER.search(text):
         spp, samples = spp * samples, 1
     text = mitsuba_scene_text(text, width, height, samples)
