@@ -12,7 +12,8 @@ For each scene of scenes/ (names without .xml; `default` is the built-in scene),
 off at 1024 spp and 16 rays (cached in target/field-study/). Then every configuration renders
 SEEDS times (default 8) at `--spp` 32 for n = 16 and 8 for n = 128, in one process, and the
 script prints per configuration the mean relMSE against the reference (relMSE = mean((x − r)²
-/ (r² + 0.01))) with its standard error over seeds, the mean render time, and the
+/ (r² + 0.01))) with its standard error over seeds, the median render time (configurations
+run interleaved, seed by seed), and the
 efficiency ratio against the first configuration: (relMSE · time) of the first over that of
 the row, with its noise from the two relMSE standard errors. Configurations whose learning
 happens between passes (auto) render their spp in passes within one render here; `ais
@@ -68,15 +69,19 @@ def main():
             render(scene, size, 1024, 16, 'off', 777, reference_path)
         reference = np.array(mi.Bitmap(reference_path))[..., :3].astype(np.float64)
         for n in ns:
-            rows = {}
-            for config in configs:
-                errors, times, counts = [], [], ()
-                for seed in range(seeds):
+            # Configurations interleaved per seed, so that the machine's drifting load
+            # falls on all of them alike; times are medians.
+            errors = {config: [] for config in configs}
+            times = {config: [] for config in configs}
+            counts = {config: () for config in configs}
+            for seed in range(seeds):
+                for config in configs:
                     out = os.path.join(WORK, f'{scene}-{config.split("+")[0]}.exr')
-                    image, seconds, counts = render(scene, size, SPP_FOR[n], n, config, seed, out)
-                    errors.append(rel_mse(image, reference))
-                    times.append(seconds)
-                rows[config] = (np.mean(errors), np.std(errors) / np.sqrt(seeds), np.mean(times), counts)
+                    image, seconds, counts[config] = render(scene, size, SPP_FOR[n], n, config, seed, out)
+                    errors[config].append(rel_mse(image, reference))
+                    times[config].append(seconds)
+            rows = {config: (np.mean(errors[config]), np.std(errors[config]) / np.sqrt(seeds),
+                             np.median(times[config]), counts[config]) for config in configs}
             base_error, base_se, base_time, _ = rows[configs[0]]
             for config in configs:
                 error, se, seconds, counts = rows[config]
