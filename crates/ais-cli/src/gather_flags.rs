@@ -68,7 +68,7 @@ pub struct GatherFlags {
     /// map field: a cell's edge in pixel footprints.
     #[arg(long)]
     field_cell: Option<String>,
-    /// map field: free pseudo-observations per texel and cell.
+    /// map field: pseudo-observations per cell (free) and texel (at its cell's visibility).
     #[arg(long)]
     field_prior: Option<String>,
     /// Mitsuba's hide_emitters: "true" hides the emitters the camera sees directly.

@@ -134,7 +134,8 @@ pub struct CellIndex(u32);
 #[derive(Clone, Debug)]
 pub struct VisibilityField {
     side: u32,
-    /// Free pseudo-observations added to every texel and cell.
+    /// Pseudo-observations added to every cell (of a free ray) and texel (at its cell's
+    /// visibility).
     prior: f32,
     /// Cell → index of its first texel in `counts`.
     cells: KeyMap<u32>,
@@ -173,7 +174,7 @@ impl VisibilityField {
         }
     }
 
-    /// This field with `prior` free pseudo-observations per texel and cell instead of
+    /// This field with `prior` pseudo-observations per texel and cell instead of
     /// [`PRIOR_FREE`] (negative or non-finite values count as 0).
     pub fn with_prior(self, prior: f32) -> Self {
         VisibilityField {
@@ -301,16 +302,18 @@ impl VisibilityField {
                 self.counts[first + texel].add(count);
                 self.totals[index].add(count);
             }
+            let cell = visibility(self.totals[index], self.prior);
             self.darkest[index] = self.counts[first..first + texels]
                 .iter()
-                .map(|&c| visibility(c, self.prior))
+                .map(|&c| texel_visibility(c, cell, self.prior))
                 .fold(1.0, f32::min);
         }
     }
 }
 
-/// Pseudo-observations of a free ray added to every texel and cell: a texel seen a few
-/// times keeps a visibility near 1, and only evidence pulls it down.
+/// Pseudo-observations added to every cell (of a free ray) and to every texel (at its
+/// cell's visibility): a texel seen a few times stays like its cell, and only its own
+/// evidence pulls it down.
 pub const PRIOR_FREE: f32 = 2.0;
 
 /// The lowest acceptance the field gives: a free ray in a texel the field calls blocked
@@ -341,7 +344,10 @@ pub fn expected_rejection(
     let skipped: f32 = counts
         .iter()
         .filter(|c| c.traced > 0)
-        .map(|&c| c.traced as f32 * (1.0 - acceptance(visibility(c, prior), cell, cost_ratio)))
+        .map(|&c| {
+            let texel = texel_visibility(c, cell, prior);
+            c.traced as f32 * (1.0 - acceptance(texel, cell, cost_ratio))
+        })
         .sum();
     skipped / total.traced as f32
 }
@@ -354,6 +360,22 @@ pub fn visibility(counts: TexelCounts, prior: f32) -> f32 {
         (counts.free as f32 + prior) / traced
     } else {
         1.0
+    }
+}
+
+/// A texel's visibility given its cell's: `prior` pseudo-observations at the cell's
+/// visibility are added to its own. A texel seen a few times is taken to be like its cell
+/// (and roulette, which rolls only texels darker than their cell, leaves it alone); only
+/// its own evidence makes it darker. (Pseudo-observations of a *free* ray, as the cell
+/// itself has, kept a texel that is always blocked but seen only tens of times about as
+/// visible as a dark cell, so roulette left it alone.)
+#[inline]
+pub fn texel_visibility(counts: TexelCounts, cell: f32, prior: f32) -> f32 {
+    let traced = counts.traced as f32 + prior;
+    if traced > 0.0 {
+        (counts.free as f32 + prior * cell) / traced
+    } else {
+        cell
     }
 }
 
@@ -425,7 +447,7 @@ impl FieldCell<'_> {
     #[inline]
     pub fn acceptance(&self, direction: [f32; 3], cost_ratio: f32) -> f32 {
         acceptance(
-            visibility(self.texel(direction), self.prior),
+            texel_visibility(self.texel(direction), self.visibility(), self.prior),
             self.visibility(),
             cost_ratio,
         )
@@ -590,6 +612,21 @@ mod tests {
     }
 
     #[test]
+    fn a_texel_is_like_its_cell_until_its_own_evidence_says_otherwise() {
+        let cell = 0.2;
+        let unseen = TexelCounts::default();
+        assert_eq!(texel_visibility(unseen, cell, PRIOR_FREE), cell);
+        // Unseen, it is traced whatever the cost ratio.
+        assert_eq!(
+            acceptance(texel_visibility(unseen, cell, 2.0), cell, 0.0),
+            1.0
+        );
+        let blocked = |traced| texel_visibility(TexelCounts { free: 0, traced }, cell, 2.0);
+        assert!(blocked(3) > 0.07, "three blocked rays are not proof");
+        assert!(blocked(300) < 0.002);
+    }
+
+    #[test]
     fn a_cell_stands_aside_unless_roulette_can_pay() {
         let mut field = VisibilityField::new(4);
         let key = CellKey::new([0.0; 3], [0.0, 1.0, 0.0], 0);
@@ -602,8 +639,11 @@ mod tests {
         field.merge(&observed);
         let cell = field.cell(&key).unwrap();
         assert!(cell.worth_rolling(1.0), "a dark texel in a bright cell");
-        // √(2 · (2 + 2) / (100 + 2) / ((102 + 2) / (200 + 2))).
-        let expected = (2.0f32 * (4.0 / 102.0) / (104.0 / 202.0)).sqrt();
+        // The texel: 2 free of 100, plus 2 pseudo-observations at the cell's visibility
+        // (102 + 2) / (200 + 2); acceptance √(2 · texel / cell).
+        let cell_visibility = 104.0f32 / 202.0;
+        let texel = (2.0 + 2.0 * cell_visibility) / 102.0;
+        let expected = (2.0 * texel / cell_visibility).sqrt();
         assert!((cell.acceptance([-1.0, 0.0, 0.0], 1.0) - expected).abs() < 1e-6);
         assert_eq!(cell.acceptance([0.0, 1.0, 0.0], 1.0), 1.0);
         assert!(!cell.worth_rolling(40.0), "rays too cheap to skip");
@@ -635,10 +675,11 @@ mod tests {
             !cell.worth_rolling(1.0),
             "too little to skip for the map work"
         );
-        // 40%: at ρ = 1 a blocked texel is accepted with √(2 · (2/402) / (602/1002)) ≈ 0.13.
+        // 40%: at ρ = 1 a blocked texel (0 free of 400, plus 2 pseudo-observations at the
+        // cell's visibility v) is accepted with √(2 · (2v / 402) / v) ≈ 0.0997, floored.
         let mut field = field_with(40);
         let unplanned = field.cell(&key).unwrap().expected_rejection(1.0);
-        let a = (2.0f32 * (2.0 / 402.0) / (602.0 / 1002.0)).sqrt();
+        let a = (2.0f32 * 2.0 / 402.0).sqrt().max(LOWEST_ACCEPTANCE);
         assert!((unplanned - 0.4 * (1.0 - a)).abs() < 1e-5);
         assert!(field.cell(&key).unwrap().worth_rolling(1.0));
         // A plan gives the same share without a pass over the texels.

@@ -18,7 +18,7 @@
 //! | `guide_fraction` | float | 0.5 | `map_use = proposal`: the guide's share of the proposal, in [0, 0.99] |
 //! | `field_res` | integer | 8 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
 //! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
-//! | `field_prior` | float | 2 | `map = field`: free pseudo-observations added to every texel and cell (how much evidence it takes to call a direction blocked) |
+//! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
 //! | `cost_ratio` | float or `measured` | `measured` | `map = field`: ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 64 of each pass but the last unless given (give it to make an image reproducible bit for bit) |
 //!
@@ -245,7 +245,8 @@ pub struct GatherSettings {
     pub field_res: u32,
     /// `map = field`: a cell's edge, in pixel footprints at the gather point.
     pub field_cell: f32,
-    /// `map = field`: free pseudo-observations added to every texel and cell.
+    /// `map = field`: pseudo-observations added to every cell (free) and texel (at its
+    /// cell's visibility).
     pub field_prior: f32,
     /// Mitsuba's `hide_emitters`: camera rays add no emission of the emitters they hit
     /// directly, and the environment seen directly is black.
