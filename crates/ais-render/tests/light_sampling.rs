@@ -411,6 +411,26 @@ fn views() -> Vec<(ShadingFrame, Vec3)> {
         .collect()
 }
 
+/// Asserts that `material`'s samples fit its density seen from each of `views` (seeds from
+/// `seed` on). Samples that come back with density 0 (a specular lobe picked, or none) are
+/// missing mass, which the density accounts for.
+fn assert_sampling_fits(
+    material: &Material,
+    seed: u64,
+    views: &[(ShadingFrame, Vec3)],
+    label: &str,
+) {
+    for (k, (frame, wo)) in views.iter().enumerate() {
+        let p = fit(
+            200_000,
+            seed + k as u64,
+            |u| Some(material.sample(frame, *wo, u)).filter(|s| s.1 > 0.0),
+            |d| material.pdf(frame, *wo, d),
+        );
+        assert!(p > SIGNIFICANCE, "{label}, view {k}: p = {p}");
+    }
+}
+
 fn conductor(microfacet: Microfacet) -> Material {
     Material {
         scattering: Scattering::RoughConductor {
@@ -444,31 +464,15 @@ fn conductor_sampling_fits_for_both_distributions() {
         Microfacet::beckmann(0.15),
         Microfacet::beckmann(0.6),
     ] {
-        let material = conductor(microfacet);
-        for (seed, (frame, wo)) in views().into_iter().enumerate() {
-            let p = fit(
-                200_000,
-                20 + seed as u64,
-                |u| Some(material.sample(&frame, wo, u)).filter(|s| s.1 > 0.0),
-                |d| material.pdf(&frame, wo, d),
-            );
-            assert!(p > SIGNIFICANCE, "{microfacet:?}, view {seed}: p = {p}");
-        }
+        let label = format!("{microfacet:?}");
+        assert_sampling_fits(&conductor(microfacet), 20, &views(), &label);
     }
 }
 
 #[test]
 fn rough_plastic_sampling_fits() {
     let material = plastic(0.25, Vec3::new(0.6, 0.3, 0.2));
-    for (seed, (frame, wo)) in views().into_iter().enumerate() {
-        let p = fit(
-            200_000,
-            30 + seed as u64,
-            |u| Some(material.sample(&frame, wo, u)).filter(|s| s.1 > 0.0),
-            |d| material.pdf(&frame, wo, d),
-        );
-        assert!(p > SIGNIFICANCE, "view {seed}: p = {p}");
-    }
+    assert_sampling_fits(&material, 30, &views(), "rough plastic");
 }
 
 fn smooth_plastic(diffuse: Vec3) -> Material {
@@ -483,15 +487,7 @@ fn smooth_plastic_base_sampling_fits() {
     // Samples that pick the mirror lobe come back with density 0 and are missing mass,
     // which the base's density accounts for: it integrates to 1 − P(mirror).
     let material = smooth_plastic(Vec3::new(0.6, 0.3, 0.2));
-    for (seed, (frame, wo)) in views().into_iter().enumerate() {
-        let p = fit(
-            200_000,
-            50 + seed as u64,
-            |u| Some(material.sample(&frame, wo, u)).filter(|s| s.1 > 0.0),
-            |d| material.pdf(&frame, wo, d),
-        );
-        assert!(p > SIGNIFICANCE, "view {seed}: p = {p}");
-    }
+    assert_sampling_fits(&material, 50, &views(), "smooth plastic");
 }
 
 fn rough_glass(microfacet: Microfacet) -> Material {
@@ -511,23 +507,16 @@ fn rough_dielectric_sampling_fits_from_both_sides() {
     // Samples refused (total internal reflection, microfacets facing away) are missing
     // mass, which the density accounts for.
     for microfacet in [Microfacet::ggx(0.3), Microfacet::beckmann(0.5)] {
-        let material = rough_glass(microfacet);
-        for (seed, (frame, wo)) in views().into_iter().enumerate() {
-            for side in [1.0f32, -1.0] {
-                // From below, the view is mirrored through the surface.
-                let wo = wo - frame.normal * (1.0 - side) * wo.dot(frame.normal);
-                let p = fit(
-                    200_000,
-                    60 + seed as u64,
-                    |u| Some(material.sample(&frame, wo, u)).filter(|s| s.1 > 0.0),
-                    |d| material.pdf(&frame, wo, d),
-                );
-                assert!(
-                    p > SIGNIFICANCE,
-                    "{microfacet:?}, view {seed}, side {side}: p = {p}"
-                );
-            }
-        }
+        // Each view, and its mirror image through the surface (seen from inside).
+        let both_sides: Vec<(ShadingFrame, Vec3)> = views()
+            .into_iter()
+            .flat_map(|(frame, wo)| {
+                let below = wo - 2.0 * frame.normal * wo.dot(frame.normal);
+                [(frame, wo), (frame, below)]
+            })
+            .collect();
+        let label = format!("rough glass, {microfacet:?}");
+        assert_sampling_fits(&rough_glass(microfacet), 60, &both_sides, &label);
     }
 }
 
