@@ -20,7 +20,7 @@
 //! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
-//! | `cost_ratio` | float or `measured` | `measured` | `map = field`: ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 64 of each pass but the last unless given (give it to make an image reproducible bit for bit) |
+//! | `cost_ratio` | float or `measured` | `measured` | `map = field`: ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass but the last unless given (give it to make an image reproducible bit for bit) |
 //!
 //! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
 //! `update`; `shared` = `map neighbours`; `warm` = `map neighbours, update aggressive`;
