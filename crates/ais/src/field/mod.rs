@@ -446,9 +446,11 @@ impl FieldCell<'_> {
     /// [`acceptance`] toward `direction`.
     #[inline]
     pub fn acceptance(&self, direction: [f32; 3], cost_ratio: f32) -> f32 {
+        // Once per candidate: this is the hot path of a rolling gather.
+        let cell = self.visibility();
         acceptance(
-            texel_visibility(self.texel(direction), self.visibility(), self.prior),
-            self.visibility(),
+            texel_visibility(self.texel(direction), cell, self.prior),
+            cell,
             cost_ratio,
         )
     }
