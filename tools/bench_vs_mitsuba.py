@@ -18,7 +18,9 @@ Reported per scene, medians over `--runs`:
   render, so the llvm variant's JIT compilation is excluded; loading excluded);
 - rays per second, counted by ais for ais; for Mitsuba, the same nominal count
   (camera rays plus `--rays` per camera sample) over its time;
-- the ratio Mitsuba llvm time / ais time (above 1: ais is faster).
+- the ratio Mitsuba llvm time / ais time (above 1: ais is faster);
+- with `--ais-embree PATH` (ais built with `--features embree`, Debian's libembree-dev),
+  that binary's render time at 2 threads and its ratio to Mitsuba llvm, in the same run.
 
 Mitsuba's llvm variant needs an LLVM library of version 16 or later (Debian: the libllvm19
 package). It is found through DRJIT_LIBLLVM_PATH or in the usual library folders; without
@@ -95,12 +97,13 @@ def mitsuba_times(scene, variant, args, libllvm):
     return statistics.median(json.loads(done.stdout.strip().splitlines()[-1])), None
 
 
-def ais_run(scene, threads, args):
-    """Median render time and counted rays of `ais render` on `scene` at `threads`."""
+def ais_run(scene, threads, args, binary=None):
+    """Median render time and counted rays of `ais render` (`binary`, else --ais) on `scene`
+    at `threads`."""
     times, rays = [], 0
     with tempfile.TemporaryDirectory() as work:
         for k in range(args.runs):
-            command = [args.ais, "render", scene, "--resolution", args.size, "--spp", str(args.spp),
+            command = [binary or args.ais, "render", scene, "--resolution", args.size, "--spp", str(args.spp),
                        "--integrator", "gather", "--strategy", "mis", "--rays", str(args.rays), "--ais", "off",
                        "--threads", str(threads), "--seed", str(k), "--no-preview",
                        "-o", os.path.join(work, "ais.exr")]
@@ -121,7 +124,8 @@ def measure(scene, args, libllvm):
     ais2, rays = ais_run(scene, 2, args)
     ais1, _ = ais_run(scene, 1, args)
     row = {"scene": os.path.relpath(scene, ROOT), "ais_2": ais2, "ais_1": ais1, "ais_rays": rays,
-           "scaling": ais1 / ais2, "nominal_rays": nominal_rays}
+           "scaling": ais1 / ais2, "nominal_rays": nominal_rays,
+           "embree_2": ais_run(scene, 2, args, args.ais_embree)[0] if args.ais_embree else None}
     for variant in ("llvm_ad_rgb", "scalar_rgb"):
         if variant == "llvm_ad_rgb" and not libllvm:
             row[variant], row[variant + "_note"] = None, "no LLVM library (install Debian's libllvm19)"
@@ -139,12 +143,17 @@ def print_rows(rows, markdown):
 
     header = ["scene", "ais 2 thr (s)", "ais rays/s", "Mitsuba llvm (s)", "llvm rays/s (nominal)",
               "llvm / ais", "Mitsuba scalar (s)", "ais 1 thr (s)", "1 → 2 threads"]
+    embree = any(row["embree_2"] for row in rows)
+    if embree:
+        header += ["ais Embree 2 thr (s)", "llvm / ais Embree"]
     lines = []
     for row in rows:
         llvm = row["llvm_ad_rgb"]
         lines.append([row["scene"], seconds(row["ais_2"]), rate(row["ais_rays"], row["ais_2"]), seconds(llvm),
                       rate(row["nominal_rays"], llvm), f"{llvm / row['ais_2']:.2f}×" if llvm else "—",
                       seconds(row["scalar_rgb"]), seconds(row["ais_1"]), f"{row['scaling']:.2f}×"])
+        if embree:
+            lines[-1] += [seconds(row["embree_2"]), f"{llvm / row['embree_2']:.2f}×" if llvm else "—"]
     if markdown:
         print("| " + " | ".join(header) + " |")
         print("|" + "---|" * len(header))
@@ -172,6 +181,7 @@ def main():
     parser.add_argument("--runs", type=int, default=3, help="timed runs per renderer (medians)")
     parser.add_argument("--timeout", type=int, default=900, help="seconds before a Mitsuba run is given up")
     parser.add_argument("--ais", default=os.path.join(ROOT, "target", "release", "ais"), help="the ais binary")
+    parser.add_argument("--ais-embree", help="an ais binary built with --features embree, timed too")
     parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
     args = parser.parse_args()
     if args.setup:
@@ -182,6 +192,9 @@ def main():
         import mitsuba  # noqa: F401
     except ImportError as e:
         crosscheck.fail_setup(f"{e}; run with --setup (makes .venv with Mitsuba and numpy)", crosscheck.NO_MITSUBA)
+    if args.ais_embree and not os.path.exists(args.ais_embree):
+        crosscheck.fail_setup(f"{args.ais_embree} not found; run "
+                              "`cargo build --release -p ais-cli --features embree` first")
     if not os.path.exists(args.ais):
         crosscheck.fail_setup(f"{args.ais} not found; run `cargo build --release -p ais-cli` first")
     if args.rays < 2 or args.rays % 2:

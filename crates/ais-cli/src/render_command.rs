@@ -293,8 +293,9 @@ fn print_summary(
         world.geometry.primitive_count()
     );
     println!(
-        "BVH build    {:.3} s",
-        world.geometry.build_time().as_secs_f64()
+        "BVH build    {:.3} s ({})",
+        world.geometry.build_time().as_secs_f64(),
+        world.geometry.accelerator_name()
     );
     println!("render time  {seconds:.3} s");
     println!(

@@ -53,6 +53,23 @@ fn sphere_hits_match_the_quadratic() {
 }
 
 #[test]
+fn a_ray_from_inside_a_sphere_meets_its_far_side() {
+    let geometry = Geometry::build(vec![ShapeInput {
+        geometry: ShapeGeometry::Sphere(Sphere {
+            center: Vec3::new(1.0, 2.0, 3.0),
+            radius: 0.5,
+        }),
+        flip_normals: false,
+    }]);
+    let ray = Ray::new(Vec3::new(1.0, 2.0, 3.1), Vec3::Z);
+    let hit = geometry.intersect(&ray).expect("the sphere's far side");
+    assert!((hit.t - 0.4).abs() < 1e-5, "t = {}", hit.t);
+    assert!(geometry.occluded(&ray));
+    let short = Ray { t_max: 0.3, ..ray };
+    assert!(!geometry.occluded(&short));
+}
+
+#[test]
 fn rectangle_from_mitsuba_transform() {
     // Mitsuba's rectangle scaled by 2 and moved to z = 5: it covers [-2, 2]² there.
     let to_world =
@@ -108,6 +125,13 @@ fn random_scene(rng: &mut Pcg32) -> Geometry {
 fn bvh_agrees_with_brute_force_on_random_rays() {
     let mut rng = Pcg32::new(31, 7);
     let geometry = random_scene(&mut rng);
+    // The backend under test: Embree when the crate is built with the feature.
+    let expected = if cfg!(feature = "embree") {
+        "Embree 3"
+    } else {
+        "obvhs CWBVH"
+    };
+    assert_eq!(geometry.accelerator_name(), expected);
     let mut hits = 0;
     for i in 0..5000 {
         let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0;

@@ -1,7 +1,9 @@
-//! Scene geometry: triangle meshes and spheres in an obvhs CWBVH, with closest-hit and
-//! occlusion queries.
+//! Scene geometry: triangle meshes and spheres in an obvhs CWBVH (or, with the cargo
+//! feature `embree`, in Intel Embree 3), with closest-hit and occlusion queries.
 
 mod basis;
+#[cfg(feature = "embree")]
+mod embree;
 mod primitive;
 mod ray;
 
@@ -69,11 +71,20 @@ pub struct Geometry {
     sources: Vec<PrimitiveSource>,
     meshes: Vec<MeshShading>,
     shape_flips: Vec<bool>,
-    bvh: Option<CwBvh>,
+    accelerator: Option<Accelerator>,
     triangle_count: usize,
     /// Centre and radius of a sphere around everything.
     bounds: (Vec3, f32),
     build_time: Duration,
+}
+
+/// What answers ray queries.
+enum Accelerator {
+    /// obvhs's compressed wide BVH (the default).
+    Cwbvh(CwBvh),
+    /// Intel Embree 3.
+    #[cfg(feature = "embree")]
+    Embree(embree::EmbreeScene),
 }
 
 /// Where a primitive came from: what shading a hit on it needs.
@@ -96,7 +107,7 @@ impl Geometry {
             sources: Vec::new(),
             meshes: Vec::new(),
             shape_flips: Vec::new(),
-            bvh: None,
+            accelerator: None,
             triangle_count: 0,
             bounds: (Vec3::ZERO, 0.0),
             build_time: Duration::ZERO,
@@ -150,9 +161,19 @@ impl Geometry {
         }
     }
 
-    /// Builds the BVH and packs the primitives in its order, so that traversal needs no
-    /// indirection.
+    /// Builds the accelerator: Embree when the feature is on and Embree starts, else the
+    /// CWBVH.
     fn build_bvh(&mut self) {
+        #[cfg(feature = "embree")]
+        if self.build_embree() {
+            return;
+        }
+        self.build_cwbvh();
+    }
+
+    /// Builds the CWBVH and packs the primitives in its order, so that traversal needs no
+    /// indirection.
+    fn build_cwbvh(&mut self) {
         let primitives = std::mem::take(&mut self.primitives);
         if primitives.is_empty() {
             return;
@@ -162,13 +183,45 @@ impl Geometry {
             obvhs::BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
-        let order = &bvh.primitive_indices;
+        self.pack_in_order(&primitives, &bvh.primitive_indices);
+        self.accelerator = Some(Accelerator::Cwbvh(bvh));
+    }
+
+    /// Packs the primitives with the triangles first, as Embree's scene numbers them, and
+    /// builds it. False (primitives kept) when Embree cannot start.
+    #[cfg(feature = "embree")]
+    fn build_embree(&mut self) -> bool {
+        let mut order: Vec<u32> = (0..self.primitives.len() as u32).collect();
+        order.sort_by_key(|&i| matches!(self.primitives[i as usize], Primitive::Sphere(_)));
+        let packed: Vec<Packed> = order
+            .iter()
+            .map(|&i| Packed::new(&self.primitives[i as usize]))
+            .collect();
+        let Some(scene) = embree::EmbreeScene::build(&packed) else {
+            return false;
+        };
+        let primitives = std::mem::take(&mut self.primitives);
+        self.pack_in_order(&primitives, &order);
+        self.accelerator = Some(Accelerator::Embree(scene));
+        true
+    }
+
+    /// Keeps the primitives packed in `order`, with their sources.
+    fn pack_in_order(&mut self, primitives: &[Primitive], order: &[u32]) {
         self.packed = order
             .iter()
             .map(|&i| Packed::new(&primitives[i as usize]))
             .collect();
         self.sources = order.iter().map(|&i| self.sources[i as usize]).collect();
-        self.bvh = Some(bvh);
+    }
+
+    /// The name of the backend that answers ray queries.
+    pub fn accelerator_name(&self) -> &'static str {
+        match &self.accelerator {
+            #[cfg(feature = "embree")]
+            Some(Accelerator::Embree(_)) => "Embree 3",
+            _ => "obvhs CWBVH",
+        }
     }
 
     /// Number of triangles.
@@ -198,7 +251,16 @@ impl Geometry {
 
     /// The closest hit along the ray, if any.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let bvh = self.bvh.as_ref()?;
+        let (index, t, barycentrics) = match self.accelerator.as_ref()? {
+            Accelerator::Cwbvh(bvh) => self.cwbvh_closest(bvh, ray)?,
+            #[cfg(feature = "embree")]
+            Accelerator::Embree(scene) => scene.intersect(ray)?,
+        };
+        Some(self.shade(index, ray, t, barycentrics))
+    }
+
+    /// The CWBVH's closest primitive along the ray: its index, distance and barycentrics.
+    fn cwbvh_closest(&self, bvh: &CwBvh, ray: &Ray) -> Option<(usize, f32, Vec2)> {
         let mut best: Option<(usize, f32, Vec2)> = None;
         let mut hit = obvhs::ray::RayHit::none();
         bvh.ray_traverse(ray.to_bvh(ray.t_max), &mut hit, |r, id| {
@@ -210,7 +272,7 @@ impl Geometry {
                 None => f32::INFINITY,
             }
         });
-        best.map(|(index, t, barycentrics)| self.shade(index, ray, t, barycentrics))
+        best
     }
 
     /// The closest hit by testing every primitive: the reference the BVH is tested against.
@@ -227,13 +289,17 @@ impl Geometry {
 
     /// Whether anything blocks the ray before `t_max` (any-hit query).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(bvh) = self.bvh.as_ref() else {
-            return false;
-        };
-        !bvh.ray_traverse_miss(ray.to_bvh(ray.t_max), |r, id| {
-            self.intersect_primitive(id, ray, r.tmax)
-                .map_or(f32::INFINITY, |(t, _)| t)
-        })
+        match &self.accelerator {
+            None => false,
+            Some(Accelerator::Cwbvh(bvh)) => {
+                !bvh.ray_traverse_miss(ray.to_bvh(ray.t_max), |r, id| {
+                    self.intersect_primitive(id, ray, r.tmax)
+                        .map_or(f32::INFINITY, |(t, _)| t)
+                })
+            }
+            #[cfg(feature = "embree")]
+            Some(Accelerator::Embree(scene)) => scene.occluded(ray),
+        }
     }
 
     fn shade(&self, index: usize, ray: &Ray, t: f32, barycentrics: Vec2) -> Hit {
