@@ -27,6 +27,12 @@ enum Command {
     /// Compare gather configurations (the talk's by default) at equal time and equal rays
     /// against a converged reference, and write an HTML report.
     Compare(Box<compare::CompareArgs>),
+    /// Write the built-in default scene as a Mitsuba 3 scene folder (default.xml, the
+    /// sculpture as PLY, the sky as EXR), to render it in Mitsuba or time both renderers.
+    ExportDefault {
+        /// The folder to write into (created if missing).
+        folder: std::path::PathBuf,
+    },
 }
 
 fn parse_resolution(text: &str) -> Result<(u32, u32), String> {
@@ -138,6 +144,11 @@ fn main() -> ExitCode {
         Command::Render(args) => render_command::run(*args),
         Command::Bench(args) => bench_command::run(args),
         Command::Compare(args) => compare::run(*args),
+        Command::ExportDefault { folder } => {
+            ais_render::default_scene::export::write_mitsuba_scene(&folder).map(|scene| {
+                println!("wrote        {}", scene.display());
+            })
+        }
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

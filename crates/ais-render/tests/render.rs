@@ -343,3 +343,32 @@ fn the_stanford_bunny_from_npm_loads_and_renders() {
         "bunny covers {covered} of 1024 pixels"
     );
 }
+
+#[test]
+fn the_exported_default_scene_renders_as_the_built_in_one() {
+    let dir = scratch("export-default");
+    let file = ais_render::default_scene::export::write_mitsuba_scene(&dir).unwrap();
+    let mut exported = World::from_description(load_scene(&file, &[]).unwrap()).unwrap();
+    exported.set_resolution((48, 27));
+    let built_in = default_world(48, 27);
+    assert_eq!(exported.sample_count, built_in.sample_count);
+    assert_eq!(
+        exported.geometry.triangle_count(),
+        built_in.geometry.triangle_count()
+    );
+    let integrator = Integrator::Gather(GatherSettings::default());
+    let (a, b) = (
+        render_with(&exported, integrator, 2).image,
+        render_with(&built_in, integrator, 2).image,
+    );
+    // The same scene, up to f32 rounding of positions and normals through the files.
+    for (i, (p, q)) in a.pixels.iter().zip(&b.pixels).enumerate() {
+        for c in 0..3 {
+            let tolerance = 1e-4 * q[c].abs().max(1.0);
+            assert!(
+                (p[c] - q[c]).abs() <= tolerance,
+                "pixel {i}: {p:?} vs {q:?}"
+            );
+        }
+    }
+}

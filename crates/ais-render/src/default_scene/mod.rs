@@ -2,6 +2,9 @@
 //! setup. A grooved sculpture of several hundred thousand triangles on a ground plane, lit by
 //! an HDRI-like procedural sky with a sun, two sphere lights and one rectangle light. The
 //! deep, narrow grooves occlude most directions from points inside them, the case AIS is for.
+//! [`export`] writes it as a Mitsuba 3 scene folder, for Mitsuba and for the benchmarks.
+
+pub mod export;
 
 use crate::bsdf::Material;
 use crate::camera::Camera;
@@ -20,6 +23,48 @@ use std::f32::consts::{PI, TAU};
 /// (408,576 after the pole rows' degenerate ones are dropped), above the talk's 400k.
 const ROWS: u32 = 400;
 const COLUMNS: u32 = 512;
+
+/// Where the camera stands and what it looks at (y up), and its horizontal field of view.
+const CAMERA_ORIGIN: DVec3 = DVec3::new(3.3, 2.0, 5.0);
+const CAMERA_TARGET: DVec3 = DVec3::new(0.0, -0.25, 0.0);
+const CAMERA_FOV_X_DEGREES: f64 = 40.0;
+
+/// The ground: Mitsuba's rectangle scaled by this, turned to face +y, lowered by 1.
+const GROUND_SCALE: f64 = 8.0;
+/// The rectangle light: Mitsuba's rectangle scaled by this (0.7 × 0.7), at this origin
+/// looking at this target, with this radiance.
+const PANEL_SCALE: f64 = 0.35;
+const PANEL_ORIGIN: DVec3 = DVec3::new(-1.6, 1.9, 1.5);
+const PANEL_TARGET: DVec3 = DVec3::new(0.0, 0.2, 0.0);
+const PANEL_RADIANCE: Vec3 = Vec3::new(12.0, 12.0, 11.0);
+
+/// A sphere light of the default scene.
+struct SphereLight {
+    center: Vec3,
+    radius: f32,
+    radiance: Vec3,
+}
+
+/// The two sphere lights: a warm one and a cool one.
+const SPHERE_LIGHTS: [SphereLight; 2] = [
+    SphereLight {
+        center: Vec3::new(1.55, 0.55, 1.25),
+        radius: 0.14,
+        radiance: Vec3::new(30.0, 20.0, 10.0),
+    },
+    SphereLight {
+        center: Vec3::new(-1.45, 0.1, -1.1),
+        radius: 0.18,
+        radiance: Vec3::new(8.0, 12.0, 25.0),
+    },
+];
+
+/// Diffuse albedos of the sculpture and the ground.
+const SCULPTURE_ALBEDO: Vec3 = Vec3::splat(0.7);
+const GROUND_ALBEDO: Vec3 = Vec3::new(0.45, 0.42, 0.38);
+
+/// The sky image's size (lat-long).
+const SKY_SIZE: (usize, usize) = (512, 256);
 
 /// The sculpture's radius in direction (θ, φ): a sphere cut by deep grooves along a twisted
 /// lattice, plus a finer ripple.
@@ -82,13 +127,8 @@ pub fn default_camera() -> CameraDescription {
     CameraDescription {
         projection: crate::scene::Projection::Perspective,
         lens: None,
-        to_world: look_at(
-            DVec3::new(3.3, 2.0, 5.0),
-            DVec3::new(0.0, -0.25, 0.0),
-            DVec3::Y,
-        )
-        .expect("valid look-at"),
-        fov_degrees: 40.0,
+        to_world: look_at(CAMERA_ORIGIN, CAMERA_TARGET, DVec3::Y).expect("valid look-at"),
+        fov_degrees: CAMERA_FOV_X_DEGREES,
         fov_axis: FovAxis::X,
     }
 }
@@ -122,47 +162,36 @@ pub fn procedural_sky(width: usize, height: usize) -> RgbImage {
     image
 }
 
+/// The sculpture with its degenerate pole triangles dropped, as a reader would.
+fn valid_sculpture() -> TriangleMesh {
+    crate::mesh::validate(std::path::Path::new("<built-in sculpture>"), sculpture())
+        .expect("the procedural sculpture is valid")
+        .mesh
+}
+
 /// The shapes and area lights of the default scene: the sculpture, the ground, the
 /// rectangle light and two sphere lights, in that order.
 fn shapes_and_lights() -> (Vec<ShapeInput>, Vec<AreaLight>) {
-    let sculpture =
-        crate::mesh::validate(std::path::Path::new("<built-in sculpture>"), sculpture())
-            .expect("the procedural sculpture is valid")
-            .mesh;
     let ground_transform = DMat4::from_translation(DVec3::new(0.0, -1.0, 0.0))
         * DMat4::from_rotation_x(-std::f64::consts::FRAC_PI_2)
-        * DMat4::from_scale(DVec3::splat(8.0));
+        * DMat4::from_scale(DVec3::splat(GROUND_SCALE));
     let ground = shapes::rectangle().transformed(ground_transform, false, false);
-    // The rectangle light: 0.7 × 0.7, facing the sculpture.
-    let panel_transform = look_at(
-        DVec3::new(-1.6, 1.9, 1.5),
-        DVec3::new(0.0, 0.2, 0.0),
-        DVec3::Y,
-    )
-    .expect("valid look-at")
-        * DMat4::from_scale(DVec3::splat(0.35));
+    // The rectangle light, facing the sculpture.
+    let panel_transform = look_at(PANEL_ORIGIN, PANEL_TARGET, DVec3::Y).expect("valid look-at")
+        * DMat4::from_scale(DVec3::splat(PANEL_SCALE));
     let panel = shapes::rectangle().transformed(panel_transform, false, false);
-    let panel_light = area_light(&panel, true, false, Vec3::new(12.0, 12.0, 11.0), 2);
+    let panel_light = area_light(&panel, true, false, PANEL_RADIANCE, 2);
     let mesh = |mesh| ShapeInput {
         geometry: ShapeGeometry::Mesh(mesh),
         flip_normals: false,
     };
-    let mut inputs = vec![mesh(sculpture), mesh(ground), mesh(panel)];
+    let mut inputs = vec![mesh(valid_sculpture()), mesh(ground), mesh(panel)];
     let mut lights = vec![panel_light];
-    let spheres = [
-        (
-            Vec3::new(1.55, 0.55, 1.25),
-            0.14,
-            Vec3::new(30.0, 20.0, 10.0),
-        ),
-        (
-            Vec3::new(-1.45, 0.1, -1.1),
-            0.18,
-            Vec3::new(8.0, 12.0, 25.0),
-        ),
-    ];
-    for (index, (center, radius, radiance)) in spheres.into_iter().enumerate() {
-        let sphere = Sphere { center, radius };
+    for (index, light) in SPHERE_LIGHTS.iter().enumerate() {
+        let sphere = Sphere {
+            center: light.center,
+            radius: light.radius,
+        };
         inputs.push(ShapeInput {
             geometry: ShapeGeometry::Sphere(sphere),
             flip_normals: false,
@@ -172,7 +201,7 @@ fn shapes_and_lights() -> (Vec<ShapeInput>, Vec<AreaLight>) {
                 sphere,
                 flipped: false,
             },
-            radiance,
+            radiance: light.radiance,
             shape_index: 3 + index as u32,
         });
     }
@@ -184,7 +213,7 @@ pub fn default_world(width: u32, height: u32) -> World {
     let (inputs, area) = shapes_and_lights();
     let geometry = Geometry::build(inputs);
     let environment = Environment::Map(Box::new(EnvironmentMap::new(
-        procedural_sky(512, 256),
+        procedural_sky(SKY_SIZE.0, SKY_SIZE.1),
         glam::DMat3::IDENTITY,
     )));
     let (_, scene_radius) = geometry.bounding_sphere();
@@ -198,8 +227,8 @@ pub fn default_world(width: u32, height: u32) -> World {
         scene_radius as f64,
     );
     let materials = vec![
-        Material::diffuse(Vec3::splat(0.7)),
-        Material::diffuse(Vec3::new(0.45, 0.42, 0.38)),
+        Material::diffuse(SCULPTURE_ALBEDO),
+        Material::diffuse(GROUND_ALBEDO),
         Material::default(),
         Material::default(),
         Material::default(),
