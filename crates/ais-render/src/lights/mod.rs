@@ -42,6 +42,17 @@ pub struct Lights {
     choice: Option<AliasTable>,
 }
 
+/// Where a candidate's shadow ray goes ([`Lights::aim`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Aim {
+    /// It surely brings nothing: no ray is needed.
+    Nothing,
+    /// It must be free up to this point (of an area light, or a point or spot light).
+    Point(Vec3),
+    /// It must be free all the way (the environment, a directional light).
+    Unbounded,
+}
+
 /// A scene's emitters, before [`Lights::new`] weighs them.
 #[derive(Clone, Debug, Default)]
 pub struct Emitters {
@@ -197,22 +208,50 @@ impl Lights {
     #[inline]
     pub fn unoccluded(&self, receiver: &Receiver, toward: &mut Toward) -> (Vec3, Option<Vec3>) {
         self.resolve(receiver, toward);
-        match toward.source {
-            Source::Delta(_, arrival) => {
-                let target = arrival
-                    .distance
-                    .is_finite()
-                    .then(|| receiver.point + arrival.direction * arrival.distance);
-                (arrival.light, target)
-            }
-            Source::Area(point) => (point.radiance, Some(point.target)),
+        let radiance = match toward.source {
+            Source::Delta(_, arrival) => arrival.light,
+            Source::Area(point) => point.radiance,
             Source::Environment => {
                 let environment = self.environment.as_ref();
-                let radiance = environment.map_or(Vec3::ZERO, |e| e.radiance_toward(toward));
-                (radiance, None)
+                environment.map_or(Vec3::ZERO, |e| e.radiance_toward(toward))
             }
-            Source::Dark | Source::Unknown => (Vec3::ZERO, None),
+            Source::Dark | Source::Unknown => Vec3::ZERO,
+        };
+        (radiance, self.target(receiver, toward))
+    }
+
+    /// Where the shadow ray of `toward` (resolved) must be free to: a finite point, or
+    /// `None` toward the environment and a directional light.
+    fn target(&self, receiver: &Receiver, toward: &Toward) -> Option<Vec3> {
+        match toward.source {
+            Source::Delta(_, arrival) => arrival
+                .distance
+                .is_finite()
+                .then(|| receiver.point + arrival.direction * arrival.distance),
+            Source::Area(point) => Some(point.target),
+            _ => None,
         }
+    }
+
+    /// Where the shadow ray of `toward` goes, known before the radiance it would bring is
+    /// looked up: [`Aim::Nothing`] when it surely brings nothing (no emitter along it, an
+    /// area light's back, a delta light sending nothing). The environment's radiance, a
+    /// texture lookup, is left for after the shadow ray, which most often is blocked
+    /// where occlusion matters; it may be zero there (a black part of the map).
+    #[inline]
+    pub fn aim(&self, receiver: &Receiver, toward: &mut Toward) -> Aim {
+        self.resolve(receiver, toward);
+        let brings_nothing = match toward.source {
+            Source::Delta(_, arrival) => arrival.light == Vec3::ZERO,
+            Source::Area(point) => point.radiance == Vec3::ZERO,
+            Source::Environment => false,
+            Source::Dark | Source::Unknown => true,
+        };
+        if brings_nothing {
+            return Aim::Nothing;
+        }
+        self.target(receiver, toward)
+            .map_or(Aim::Unbounded, Aim::Point)
     }
 
     /// Finds what a direction of unknown source meets first among the emitters: the nearest

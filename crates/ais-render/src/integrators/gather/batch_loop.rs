@@ -3,7 +3,7 @@
 //! renderer.
 
 use super::guiding::CandidateSampler;
-use super::light::Leaving;
+use super::light::{free_radiance, Leaving};
 use super::settings::{GatherSettings, MapUse};
 use super::strategy::GatherPoint;
 use crate::lights::{luminance, Toward};
@@ -90,6 +90,9 @@ pub fn run_batch<P: BatchProbe>(
     let at = run.at;
     probe.started();
     batch.begin(run.settings.rays, run.seed, run.start);
+    // Without a map, observations or a recorder, nothing reads what a traced ray saw
+    // besides its value: a blocked ray can skip the lookups its value would need.
+    let value_only = batch.map().is_none() && batch.observations().is_none() && recorder.is_none();
     let mut values = RunningMean::default();
     while let Some(candidate) = batch.next_candidate() {
         let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
@@ -103,15 +106,21 @@ pub fn run_batch<P: BatchProbe>(
         let (decision, known) = decide(run, batch, &mut values, &mut toward, in_support);
         if let Decision::Trace { .. } = decision {
             let started = run.clock.map(|_| Instant::now());
-            let (value, rating) = trace(run, toward, known, counts);
-            if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), rating.free()) {
-                recorder.record(direction.into(), free);
-            }
-            batch.record(value.to_array(), rating.rating);
+            let (value, rating) = if value_only && known.is_none() {
+                // Nothing reads the rating: the batch has no map to learn.
+                (traced_value(run, toward, counts), 0.0)
+            } else {
+                let (value, seen) = trace(run, toward, known, counts);
+                if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), seen.free()) {
+                    recorder.record(direction.into(), free);
+                }
+                (value, seen.rating)
+            };
+            batch.record(value.to_array(), rating);
             if let (Some(clock), Some(started)) = (run.clock, started) {
                 clock.set(clock.get() + started.elapsed());
             }
-            probe.recorded(batch, value.to_array(), rating.rating);
+            probe.recorded(batch, value.to_array(), rating);
         }
     }
     let estimate = batch.finish();
@@ -198,6 +207,22 @@ impl Seen {
     fn free(&self) -> Option<bool> {
         self.traced.then_some(self.rating > 0.0)
     }
+}
+
+/// Traces an accepted candidate whose value alone is wanted: its contribution f·L/p, with
+/// the density, the BSDF and the environment's radiance looked up only if its shadow ray is
+/// free. The same value as [`trace`] gives.
+fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> Vec3 {
+    let at = run.at;
+    let Some(radiance) = free_radiance(run.world, at, &mut toward, counts) else {
+        return Vec3::ZERO;
+    };
+    let pdf = run.sampler.pdf(at, &mut toward);
+    // A zero density, possible only at a light's rim in f32, brings nothing.
+    if pdf <= 0.0 || radiance == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    at.scattering(&toward) * radiance / pdf as f32
 }
 
 /// Traces an accepted candidate: its contribution f·L/p and what it saw.

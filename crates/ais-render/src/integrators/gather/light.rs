@@ -3,7 +3,7 @@
 
 use super::strategy::GatherPoint;
 use crate::geometry::{spawn_ray, spawn_ray_to, Ray};
-use crate::lights::Toward;
+use crate::lights::{Aim, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
 use glam::Vec3;
@@ -23,14 +23,7 @@ impl Leaving {
     #[inline]
     pub fn new(world: &World, at: &GatherPoint, toward: &mut Toward) -> Self {
         let (unoccluded, target) = world.lights.unoccluded(&at.receiver, toward);
-        let (point, normal) = (at.receiver.point, at.frame.geometric);
-        // Aimed at the light's point from the offset origin, so that the ray ends just short
-        // of it whatever the offset (a ray along the direction from the offset origin can
-        // meet a curved light well before the point, near its rim).
-        let ray = match target {
-            Some(target) => spawn_ray_to(point, normal, target),
-            None => spawn_ray(point, normal, toward.direction),
-        };
+        let ray = shadow_ray(at, toward.direction, target);
         Leaving { ray, unoccluded }
     }
 
@@ -49,6 +42,44 @@ impl Leaving {
             self.unoccluded
         }
     }
+}
+
+/// The shadow ray leaving `at` along `direction`, free up to `target` if given.
+fn shadow_ray(at: &GatherPoint, direction: Vec3, target: Option<Vec3>) -> Ray {
+    let (point, normal) = (at.receiver.point, at.frame.geometric);
+    // Aimed at the light's point from the offset origin, so that the ray ends just short of
+    // it whatever the offset (a ray along the direction from the offset origin can meet a
+    // curved light well before the point, near its rim).
+    match target {
+        Some(target) => spawn_ray_to(point, normal, target),
+        None => spawn_ray(point, normal, direction),
+    }
+}
+
+/// The radiance a candidate brings if its shadow ray is free: `None` when the ray is
+/// blocked, or when it surely brings nothing (then no ray is traced). The ray is traced
+/// before the radiance is looked up (for the environment, a texture lookup), which a
+/// blocked ray does not need. A ray toward a black part of the environment is traced
+/// (and counted), where [`Leaving`] would know not to.
+pub fn free_radiance(
+    world: &World,
+    at: &GatherPoint,
+    toward: &mut Toward,
+    counts: &mut RayCounts,
+) -> Option<Vec3> {
+    let target = match world.lights.aim(&at.receiver, toward) {
+        Aim::Nothing => return None,
+        Aim::Point(target) => Some(target),
+        Aim::Unbounded => None,
+    };
+    counts.occlusion += 1;
+    if world
+        .geometry
+        .occluded(&shadow_ray(at, toward.direction, target))
+    {
+        return None;
+    }
+    Some(world.lights.unoccluded(&at.receiver, toward).0)
 }
 
 /// Light arriving at the gather point from a candidate direction, occluders included:
