@@ -57,11 +57,12 @@ pub struct EnvironmentMap {
     partitions: super::environment_guide::PartitionCache,
 }
 
-/// Where a direction falls on an environment map: Mitsuba's (u, v) and the sampling cell.
+/// Where a direction falls on an environment map: Mitsuba's u, cos θ (v = acos(cos θ) / π,
+/// worked out only when the radiance is looked up) and the sampling cell.
 #[derive(Clone, Copy, Debug)]
 pub struct MapLocation {
     u: f32,
-    v: f32,
+    cos_theta: f32,
     cell: usize,
 }
 
@@ -126,7 +127,7 @@ impl EnvironmentMap {
         let row = ((v * rows as f32) as usize).min(rows - 1);
         MapLocation {
             u,
-            v,
+            cos_theta: d.y,
             cell: row * width + column,
         }
     }
@@ -145,7 +146,8 @@ impl EnvironmentMap {
             (x0 as usize).min(width - 1)
         };
         let c1 = if c0 + 1 == width { 0 } else { c0 + 1 };
-        let y = location.v.clamp(0.0, 1.0) * (height - 1) as f32;
+        let v = fast_trig::acos(location.cos_theta) * (1.0 / PI32);
+        let y = v.clamp(0.0, 1.0) * (height - 1) as f32;
         let r0 = (y as usize).min(height - 2);
         let fy = y - r0 as f32;
         let texel = |c: usize, r: usize| Vec3::from(self.image.pixels[r * width + c]);
@@ -159,8 +161,8 @@ impl EnvironmentMap {
     /// ([`EnvironmentMap::density_at`]).
     #[inline]
     pub(crate) fn sample(&self, u: [f32; 2]) -> Toward {
-        let (cell, within) = self.cells.sample(u);
-        self.toward_in_cell(cell, within)
+        let (row, column, within) = self.cells.sample_row_column(u);
+        self.toward_in_row_column(row, column, within)
     }
 
     /// The sampling density at a located direction, in solid angle.
@@ -219,9 +221,15 @@ impl EnvironmentMap {
     /// [`EnvironmentMap::direction_in_cell`], located: its (u, v) follow from the cell and
     /// the fractions without a second trip through atan2.
     #[inline]
-    pub(crate) fn toward_in_cell(&self, cell: usize, [fx, fy]: [f32; 2]) -> Toward {
+    pub(crate) fn toward_in_cell(&self, cell: usize, within: [f32; 2]) -> Toward {
         let width = self.image.width;
-        let (column, row) = (cell % width, cell / width);
+        self.toward_in_row_column(cell / width, cell % width, within)
+    }
+
+    /// [`EnvironmentMap::toward_in_cell`] for the cell at `row` and `column`.
+    #[inline]
+    fn toward_in_row_column(&self, row: usize, column: usize, [fx, fy]: [f32; 2]) -> Toward {
+        let width = self.image.width;
         let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
         let cos_theta = (top + fy * (bottom - top)).clamp(-1.0, 1.0);
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
@@ -234,8 +242,8 @@ impl EnvironmentMap {
         let local = Vec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
         let location = MapLocation {
             u,
-            v: fast_trig::acos(cos_theta) * (1.0 / PI32),
-            cell,
+            cos_theta,
+            cell: row * width + column,
         };
         Toward::from_environment((self.to_world * local).normalize(), Some(location))
     }

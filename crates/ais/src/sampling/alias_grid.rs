@@ -78,10 +78,17 @@ impl AliasGrid {
     /// and independent of the cell when `u` is uniform.
     #[inline]
     pub fn sample(&self, u: [f32; 2]) -> (usize, [f32; 2]) {
+        let (row, column, left) = self.sample_row_column(u);
+        (row * self.columns + column, left)
+    }
+
+    /// [`AliasGrid::sample`], giving the cell as its row and column.
+    #[inline]
+    pub fn sample_row_column(&self, u: [f32; 2]) -> (usize, usize, [f32; 2]) {
         let (row, left_y) = self.rows.sample(u[1]);
         let start = row * self.columns;
         let (column, left_x) = draw(&self.cells[start..start + self.columns], u[0]);
-        (start + column, [left_x, left_y])
+        (row, column, [left_x, left_y])
     }
 }
 
