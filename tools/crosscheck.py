@@ -7,7 +7,8 @@
     .venv/bin/python tools/crosscheck.py --suite   # every scene the test suite checks
 
 Each scene is rendered by Mitsuba's `direct` integrator (scalar_rgb; `--mitsuba-samples`
-emitter and BSDF samples per camera sample; a box pixel filter like ours) and by
+emitter and BSDF samples per camera sample; the scene's own reconstruction filter, Mitsuba's
+Gaussian when it names none, as ais reads it) and by
 `ais render` (gather, MIS, once per `--modes` entry: AIS off and per-batch AIS by default),
 at the same resolution. Each renderer runs `--runs` times with independent seeds, and the
 spread of those runs gives a per-pixel standard error (SE) for both images. Reported per
@@ -87,8 +88,8 @@ def setup_venv(venv):
 
 
 def mitsuba_scene_text(text, width, height, samples):
-    """The scene for Mitsuba: its `direct` integrator (keeping the scene's hide_emitters), our
-    film size and a box filter."""
+    """The scene for Mitsuba: its `direct` integrator (keeping the scene's hide_emitters) and
+    our film size; the reconstruction filter stays the scene's."""
     hidden = re.search(r'<integrator\b.*?<boolean\s+name="hide_emitters"\s+value="true"\s*/>.*?</integrator>',
                        text, flags=re.S)
     hide = '<boolean name="hide_emitters" value="true"/>' if hidden else ''
@@ -106,14 +107,12 @@ def mitsuba_scene_text(text, width, height, samples):
                                   rf"\g<1>{value}\g<2>", body)
             if not found:
                 body = re.sub(r"(<film\b[^>]*>)", rf'\1<integer name="{name}" value="{value}"/>', body)
-        # ais reconstructs pixels with a box filter; Mitsuba's hdrfilm defaults to a Gaussian.
-        body = re.sub(r"<rfilter\b[^>]*/>|<rfilter\b.*?</rfilter>", "", body, flags=re.S)
-        return re.sub(r"(<film\b[^>]*>)", r'\1<rfilter type="box"/>', body, count=1)
+        return body
 
     text, films = re.subn(r"<film\b.*?</film>", film, text, count=1, flags=re.S)
     if films == 0:
         text = re.sub(r"(<sensor\b[^>]*>)", rf'\1<film type="hdrfilm"><integer name="width" value="{width}"/>'
-                      rf'<integer name="height" value="{height}"/><rfilter type="box"/></film>', text, count=1)
+                      rf'<integer name="height" value="{height}"/></film>', text, count=1)
     return text
 
 
@@ -189,6 +188,23 @@ def render_ais(binary, scene, width, height, runs, spp, rays, mode, work):
     return np.stack(images).astype(np.float64)
 
 
+def correlation_inflation(ours, theirs, variance):
+    """How much larger the variance of an 8x8 block's mean is than the sum of its pixels'
+    variances over 64^2: the median over blocks and channels of the ratio, the block means'
+    variance taken from the runs' spread (at least 1: pixels rendered independently)."""
+    import numpy as np
+    height, width = variance.shape[:2]
+    ratios = []
+    for y in range(0, height, BLOCK):
+        for x in range(0, width, BLOCK):
+            count = min(BLOCK, height - y) * min(BLOCK, width - x)
+            direct = sum(stack[:, y:y + BLOCK, x:x + BLOCK].reshape(stack.shape[0], -1, 3).mean(1)
+                         .var(0, ddof=1) / stack.shape[0] for stack in (ours, theirs))
+            independent = variance[y:y + BLOCK, x:x + BLOCK].reshape(-1, 3).sum(0) / count ** 2
+            ratios.extend(direct[independent > 0] / independent[independent > 0])
+    return max(1.0, float(np.median(ratios))) if ratios else 1.0
+
+
 def statistics(ours, theirs):
     """Compares two stacks of independent runs (runs, H, W, 3)."""
     import numpy as np
@@ -209,9 +225,13 @@ def statistics(ours, theirs):
     # The difference of the image means in SEs: is a ratio's offset noise or a real difference?
     # Rounding is the same in every pixel of a flat region, so its floor does not average
     # away over many pixels as noise does.
+    # A reconstruction filter wider than a pixel (Mitsuba's default Gaussian) correlates
+    # neighbouring pixels, so the SE of a mean over pixels exceeds what the pixels' own SEs
+    # give if taken as independent; `inflation` measures by how much, over all blocks.
+    inflation = correlation_inflation(ours, theirs, variance)
     pixels = difference.shape[0] * difference.shape[1]
     mean_z = difference.reshape(-1, 3).mean(0) / np.sqrt(
-        variance.reshape(-1, 3).sum(0) / pixels ** 2 + floor.reshape(-1, 3).mean(0))
+        inflation * variance.reshape(-1, 3).sum(0) / pixels ** 2 + floor.reshape(-1, 3).mean(0))
     height, width = difference.shape[:2]
     worst = (0.0, None)
     for y in range(0, height, BLOCK):
@@ -219,7 +239,7 @@ def statistics(ours, theirs):
             d = difference[y:y + BLOCK, x:x + BLOCK].reshape(-1, 3)
             v = variance[y:y + BLOCK, x:x + BLOCK].reshape(-1, 3)
             f = floor[y:y + BLOCK, x:x + BLOCK].reshape(-1, 3)
-            block_z = d.mean(0) / np.sqrt(v.sum(0) / d.shape[0] ** 2 + f.mean(0))
+            block_z = d.mean(0) / np.sqrt(inflation * v.sum(0) / d.shape[0] ** 2 + f.mean(0))
             channel = int(np.abs(block_z).argmax())
             if abs(block_z[channel]) > abs(worst[0]):
                 worst = (float(block_z[channel]), (x, y, "RGB"[channel]))
@@ -231,6 +251,7 @@ def statistics(ours, theirs):
         "mean_ratio": [float(r) for r in ratio],
         "mean_difference_se": [float(z) for z in mean_z],
         "rel_mse": rel_mse,
+        "correlation_inflation": inflation,
         "rel_mse_noise_floor": noise_floor,
         "worst_block_se": worst[0],
         "worst_block": worst[1],

@@ -16,7 +16,7 @@ def test_compare_returns_tables_and_writes_the_report(cornell, tmp_path):
         resolution=(32, 32),
         time_budget=0.1,
         seeds=2,
-        reference_spp=8,
+        reference_spp=256,
         configs=["off", "aggressive"],
         rays=8,
     )

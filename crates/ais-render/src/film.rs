@@ -1,26 +1,100 @@
-//! The film: box-filtered pixel samples accumulated per pixel.
+//! The film: camera samples accumulated into pixels through a reconstruction filter.
+//!
+//! With Mitsuba's `box` filter a sample counts in its own pixel only. With a wider filter
+//! (`tent`, or `gaussian`, Mitsuba's default) a sample at image position p adds its value
+//! times w(p − c) to every pixel whose centre c lies within the filter's radius, where w is
+//! the separable product of the filter's weights along x and y, and a pixel's value is its
+//! sum of weighted values over its sum of weights, as Mitsuba's `hdrfilm` develops it.
+//! Samples are drawn inside the image only (Mitsuba's `sample_border` is false).
 
 use crate::image_io::RgbImage;
+use crate::render::PixelRect;
 
-/// Accumulates weighted samples per pixel and averages them (a box filter over the pixel).
-/// A render in passes adds each pass's pixel mean weighted by its samples per pixel.
+/// How a camera sample weighs in the pixels around it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ReconstructionFilter {
+    /// Each sample counts in its own pixel only (Mitsuba's `box`).
+    Box,
+    /// Mitsuba's `tent`: weight 1 − |x| / radius along each axis.
+    Tent {
+        /// Radius in pixels.
+        radius: f32,
+    },
+    /// Mitsuba's `gaussian` (its default): exp(−x² / 2σ²) − exp(−r² / 2σ²), clipped at 0,
+    /// along each axis, with radius r = 4σ.
+    Gaussian {
+        /// σ in pixels.
+        stddev: f32,
+    },
+}
+
+impl ReconstructionFilter {
+    /// Mitsuba's default filter: a Gaussian of σ = ½ pixel.
+    pub const MITSUBA_DEFAULT: Self = ReconstructionFilter::Gaussian { stddev: 0.5 };
+
+    /// How far from a sample, in pixels, the filter reaches.
+    pub fn radius(&self) -> f32 {
+        match *self {
+            ReconstructionFilter::Box => 0.5,
+            ReconstructionFilter::Tent { radius } => radius,
+            ReconstructionFilter::Gaussian { stddev } => 4.0 * stddev,
+        }
+    }
+
+    /// The weight along one axis at distance `x` (pixels) from the sample.
+    pub fn eval(&self, x: f32) -> f32 {
+        match *self {
+            ReconstructionFilter::Box => {
+                if x.abs() <= 0.5 {
+                    1.0
+                } else {
+                    0.0
+                }
+            }
+            ReconstructionFilter::Tent { radius } => (1.0 - x.abs() / radius).max(0.0),
+            ReconstructionFilter::Gaussian { stddev } => {
+                let alpha = -1.0 / (2.0 * stddev * stddev);
+                let radius = 4.0 * stddev;
+                ((alpha * x * x).exp() - (alpha * radius * radius).exp()).max(0.0)
+            }
+        }
+    }
+
+    /// How many pixels beyond its own a sample can reach (0: the box).
+    pub fn margin(&self) -> usize {
+        match self {
+            ReconstructionFilter::Box => 0,
+            _ => (self.radius() - 0.5).ceil().max(0.0) as usize,
+        }
+    }
+}
+
+/// Weighted sums of samples over a rectangle of an image's pixels.
 #[derive(Clone, Debug)]
 pub struct Film {
-    width: usize,
-    height: usize,
+    rect: PixelRect,
     sums: Vec<[f64; 3]>,
     weights: Vec<f64>,
 }
 
 impl Film {
-    /// An empty film.
+    /// An empty `width × height` film.
     pub fn new(width: usize, height: usize) -> Self {
+        Film::covering(PixelRect::whole(width, height))
+    }
+
+    /// An empty film over the pixels of `rect` (in the whole image's coordinates).
+    pub fn covering(rect: PixelRect) -> Self {
         Film {
-            width,
-            height,
-            sums: vec![[0.0; 3]; width * height],
-            weights: vec![0.0; width * height],
+            rect,
+            sums: vec![[0.0; 3]; rect.area()],
+            weights: vec![0.0; rect.area()],
         }
+    }
+
+    /// The pixels it covers.
+    pub fn rect(&self) -> PixelRect {
+        self.rect
     }
 
     /// Adds a sample to pixel (x, y).
@@ -28,32 +102,158 @@ impl Film {
         self.add_weighted(x, y, value, 1.0);
     }
 
-    /// Adds a sample of weight `weight` (e.g. the mean of that many samples) to pixel (x, y).
+    /// Adds a sample of weight `weight` (e.g. the mean of that many samples) to pixel (x, y)
+    /// of the image (which must be covered).
     pub fn add_weighted(&mut self, x: usize, y: usize, value: [f32; 3], weight: f64) {
-        let index = y * self.width + x;
+        let index = (y - self.rect.y0) * self.rect.width() + (x - self.rect.x0);
         for (sum, v) in self.sums[index].iter_mut().zip(value) {
             *sum += v as f64 * weight;
         }
         self.weights[index] += weight;
     }
 
-    /// The averaged image (pixels without samples are black).
-    pub fn image(&self) -> RgbImage {
+    /// Adds a sample at image position `position` (pixels; pixel (x, y) spans [x, x + 1) ×
+    /// [y, y + 1)) to the covered pixels within `filter`'s reach.
+    pub fn splat(&mut self, filter: &ReconstructionFilter, position: [f32; 2], value: [f32; 3]) {
+        let radius = filter.radius();
+        let span = |p: f32, low: usize, high: usize| {
+            // Pixels whose centres i + ½ lie within the radius of p.
+            let first = (p - 0.5 - radius).ceil().max(low as f32) as usize;
+            let last = ((p - 0.5 + radius).floor() as i64).min(high as i64 - 1);
+            (first, last)
+        };
+        let (x_first, x_last) = span(position[0], self.rect.x0, self.rect.x1);
+        let (y_first, y_last) = span(position[1], self.rect.y0, self.rect.y1);
+        for y in y_first as i64..=y_last {
+            let wy = filter.eval(y as f32 + 0.5 - position[1]);
+            for x in x_first as i64..=x_last {
+                let weight = wy * filter.eval(x as f32 + 0.5 - position[0]);
+                if weight > 0.0 {
+                    self.add_weighted(x as usize, y as usize, value, weight as f64);
+                }
+            }
+        }
+    }
+
+    /// Adds the sums and weights of `other` where the two overlap.
+    pub fn add_film(&mut self, other: &Film) {
+        let Some(overlap) = self.rect.intersection(&other.rect) else {
+            return;
+        };
+        for (x, y) in overlap.pixels() {
+            let from = (y - other.rect.y0) * other.rect.width() + (x - other.rect.x0);
+            let to = (y - self.rect.y0) * self.rect.width() + (x - self.rect.x0);
+            for (sum, add) in self.sums[to].iter_mut().zip(other.sums[from]) {
+                *sum += add;
+            }
+            self.weights[to] += other.weights[from];
+        }
+    }
+
+    /// The averaged image of the pixels of `rect` (covered; pixels without samples are
+    /// black).
+    pub fn image_of(&self, rect: PixelRect) -> RgbImage {
+        let pixels = rect
+            .pixels()
+            .map(|(x, y)| {
+                let index = (y - self.rect.y0) * self.rect.width() + (x - self.rect.x0);
+                let weight = self.weights[index];
+                if weight == 0.0 {
+                    [0.0; 3]
+                } else {
+                    self.sums[index].map(|s| (s / weight) as f32)
+                }
+            })
+            .collect();
         RgbImage {
-            width: self.width,
-            height: self.height,
-            pixels: self
-                .sums
-                .iter()
-                .zip(&self.weights)
-                .map(|(sum, &weight)| {
-                    if weight == 0.0 {
-                        [0.0; 3]
-                    } else {
-                        sum.map(|s| (s / weight) as f32)
-                    }
-                })
-                .collect(),
+            width: rect.width(),
+            height: rect.height(),
+            pixels,
+        }
+    }
+
+    /// The averaged image of every covered pixel.
+    pub fn image(&self) -> RgbImage {
+        self.image_of(self.rect)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mitsuba_gaussian_weights_and_reach() {
+        let filter = ReconstructionFilter::MITSUBA_DEFAULT;
+        assert_eq!(filter.radius(), 2.0);
+        assert_eq!(filter.margin(), 2);
+        // exp(−2x²) − exp(−8): Mitsuba's windowed Gaussian at σ = ½.
+        let bias = (-8.0f32).exp();
+        assert!((filter.eval(0.0) - (1.0 - bias)).abs() < 1e-7);
+        assert!((filter.eval(1.0) - ((-2.0f32).exp() - bias)).abs() < 1e-7);
+        assert_eq!(filter.eval(2.0), 0.0);
+        assert_eq!(ReconstructionFilter::Box.margin(), 0);
+        assert_eq!(ReconstructionFilter::Tent { radius: 1.0 }.margin(), 1);
+    }
+
+    #[test]
+    fn a_splat_reaches_the_pixels_within_the_radius_only() {
+        let filter = ReconstructionFilter::Tent { radius: 1.0 };
+        let mut film = Film::new(4, 4);
+        // At the centre of pixel (1, 1): only that pixel's centre lies within a tent of
+        // radius 1 (the neighbours' centres are exactly 1 away, where the tent is 0).
+        film.splat(&filter, [1.5, 1.5], [2.0; 3]);
+        let image = film.image();
+        assert_eq!(image.pixels[4 + 1], [2.0; 3]);
+        assert_eq!(image.pixels.iter().filter(|p| p[0] != 0.0).count(), 1);
+        // On the corner between four pixels, each gets a quarter of the weight: the
+        // normalised value is the sample's in all four.
+        let mut film = Film::new(4, 4);
+        film.splat(&filter, [2.0, 2.0], [3.0; 3]);
+        let image = film.image();
+        for (x, y) in [(1, 1), (2, 1), (1, 2), (2, 2)] {
+            assert!((image.pixels[y * 4 + x][0] - 3.0).abs() < 1e-6);
+        }
+        assert_eq!(image.pixels.iter().filter(|p| p[0] != 0.0).count(), 4);
+    }
+
+    #[test]
+    fn films_of_parts_add_up_to_the_film_of_the_whole() {
+        let filter = ReconstructionFilter::MITSUBA_DEFAULT;
+        let samples = [
+            ([0.3f32, 0.7f32], 1.0f32),
+            ([3.9, 2.2], 5.0),
+            ([2.5, 3.5], 2.0),
+        ];
+        let mut whole = Film::new(5, 4);
+        let mut left = Film::covering(PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: 3,
+            y1: 4,
+        });
+        let mut right = Film::covering(PixelRect {
+            x0: 1,
+            y0: 0,
+            x1: 5,
+            y1: 4,
+        });
+        for (position, value) in samples {
+            whole.splat(&filter, position, [value; 3]);
+            let part = if position[0] < 2.0 {
+                &mut left
+            } else {
+                &mut right
+            };
+            part.splat(&filter, position, [value; 3]);
+        }
+        let mut merged = Film::new(5, 4);
+        merged.add_film(&left);
+        merged.add_film(&right);
+        for (a, b) in merged.image().pixels.iter().zip(whole.image().pixels) {
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() <= 1e-6 * b[c].abs(), "{a:?} vs {b:?}");
+            }
         }
     }
 }

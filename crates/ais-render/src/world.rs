@@ -22,6 +22,8 @@ pub struct World {
     pub camera: Camera,
     /// Film width and height.
     pub resolution: (u32, u32),
+    /// How camera samples become pixels.
+    pub filter: crate::film::ReconstructionFilter,
     /// Samples per pixel from the scene file.
     pub sample_count: u32,
     /// The emitters.
@@ -256,6 +258,7 @@ impl World {
             albedo_textures: textures.per_shape,
             camera: Camera::new(&description.camera, width, height),
             resolution: description.resolution,
+            filter: description.filter,
             sample_count: description.sample_count,
             description,
             warnings,

@@ -2,6 +2,7 @@
 //! model from npm (the Stanford bunny).
 
 use ais_render::default_scene::default_world;
+use ais_render::film::ReconstructionFilter;
 use ais_render::integrators::gather::{self, GatherStats};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Sharing};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
@@ -97,6 +98,32 @@ fn pasted_crops(world: &World, integrator: &Integrator, crops: &[[usize; 4]]) ->
         }
     }
     pasted.iter().flatten().map(|c| c.to_bits()).collect()
+}
+
+#[test]
+fn a_wide_filter_keeps_crops_and_threads_exact() {
+    // Mitsuba's default Gaussian spreads each sample over the pixels within 2 of it: a
+    // crop renders the pixels around it too, and tiles' splats add up in a fixed order.
+    let mut world = default_world(48, 27);
+    world.filter = ReconstructionFilter::MITSUBA_DEFAULT;
+    let uneven = [[0, 0, 17, 27], [17, 0, 31, 10], [17, 10, 31, 17]];
+    for gather in [Preset::Off, Preset::Conservative].map(GatherSettings::preset) {
+        let integrator = Integrator::Gather(gather);
+        let whole = thread_independent(&world, gather);
+        assert_eq!(
+            pasted_crops(&world, &integrator, &uneven),
+            bits(&whole.image),
+            "{gather:?}"
+        );
+        // The filter changes the image: it is not the box's.
+        let mut boxed = default_world(48, 27);
+        boxed.filter = ReconstructionFilter::Box;
+        assert_ne!(
+            bits(&on_threads(&boxed, 1, integrator).image),
+            bits(&whole.image)
+        );
+    }
+    thread_independent(&world, GatherSettings::preset(Preset::Shared));
 }
 
 #[test]

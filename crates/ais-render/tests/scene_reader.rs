@@ -140,15 +140,55 @@ fn ignored_properties_and_filters_are_warned_about() {
     let scene = parse(
         r#"<scene version="3.0.0">
         <sensor type="perspective"><float name="shutter" value="1"/>
-          <film type="hdrfilm"><rfilter type="gaussian"/></film></sensor>
+          <film type="hdrfilm"><rfilter type="mitchell"/></film></sensor>
         <shape type="cube"><float name="weird" value="1"/></shape>
         </scene>"#,
     )
     .unwrap();
     let all = scene.warnings.join("\n");
     assert!(all.contains("test.xml:2: property \"shutter\""), "{all}");
-    assert!(all.contains("gaussian"), "{all}");
+    assert!(all.contains("\"mitchell\" replaced by a Gaussian"), "{all}");
     assert!(all.contains("test.xml:4: property \"weird\""), "{all}");
+}
+
+#[test]
+fn reconstruction_filters_take_mitsubas_defaults() {
+    use ais_render::film::ReconstructionFilter;
+    let filter = |film: &str| {
+        let text =
+            format!(r#"<scene version="3.0.0"><sensor type="perspective">{film}</sensor></scene>"#);
+        parse(&text).map(|scene| (scene.filter, scene.warnings))
+    };
+    // No film, or a film without a filter: Mitsuba's Gaussian of σ = ½.
+    let gaussian = ReconstructionFilter::Gaussian { stddev: 0.5 };
+    assert_eq!(filter("").unwrap().0, gaussian);
+    assert_eq!(filter(r#"<film type="hdrfilm"/>"#).unwrap().0, gaussian);
+    let read = |rfilter: &str| filter(&format!(r#"<film type="hdrfilm">{rfilter}</film>"#));
+    assert_eq!(
+        read(r#"<rfilter type="box"/>"#).unwrap().0,
+        ReconstructionFilter::Box
+    );
+    assert_eq!(
+        read(r#"<rfilter type="tent"/>"#).unwrap().0,
+        ReconstructionFilter::Tent { radius: 1.0 }
+    );
+    let wide = read(r#"<rfilter type="gaussian"><float name="stddev" value="0.75"/></rfilter>"#);
+    assert_eq!(
+        wide.unwrap().0,
+        ReconstructionFilter::Gaussian { stddev: 0.75 }
+    );
+    let (_, warnings) =
+        read(r#"<rfilter type="box"><float name="width" value="2"/></rfilter>"#).unwrap();
+    assert!(
+        warnings.join("\n").contains("property \"width\""),
+        "{warnings:?}"
+    );
+    let bad = read(r#"<rfilter type="gaussian"><float name="stddev" value="0"/></rfilter>"#);
+    let message = bad.unwrap_err().to_string();
+    assert!(
+        message.contains("test.xml:1") && message.contains("stddev"),
+        "{message}"
+    );
 }
 
 #[test]

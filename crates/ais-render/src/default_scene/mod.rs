@@ -8,6 +8,7 @@ pub mod export;
 
 use crate::bsdf::Material;
 use crate::camera::Camera;
+use crate::film::ReconstructionFilter;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Sphere};
 use crate::image_io::RgbImage;
 use crate::lights::{AreaLight, AreaShape, Emitters, Environment, EnvironmentMap, Lights};
@@ -238,6 +239,7 @@ pub fn default_world(width: u32, height: u32) -> World {
         file: crate::request::BUILT_IN_NAME.into(),
         camera: camera_description.clone(),
         resolution: (width, height),
+        filter: ReconstructionFilter::Box,
         sample_count: 4,
         shapes: Vec::new(),
         bsdfs: Vec::new(),
@@ -255,6 +257,7 @@ pub fn default_world(width: u32, height: u32) -> World {
         materials,
         camera: Camera::new(&camera_description, width, height),
         resolution: (width, height),
+        filter: ReconstructionFilter::Box,
         sample_count: 4,
         description,
         warnings: Vec::new(),

@@ -18,7 +18,7 @@ pub use counts::RayCounts;
 pub use integrator::{Learning, SampleIntegrator, TileState, TileStats};
 pub use tile::{pixel_seed, tiles, PixelRect, Tile, TILE_SIZE};
 
-use crate::film::Film;
+use crate::film::{Film, ReconstructionFilter};
 use crate::image_io::RgbImage;
 use crate::world::World;
 use ais::rng::Pcg32;
@@ -70,11 +70,18 @@ impl<S> RenderOutput<S> {
     }
 }
 
+/// A tile's camera samples in one pass.
+enum TileSamples {
+    /// Box filter: the mean of each pixel's samples, row-major over the tile.
+    Means(Vec<[f32; 3]>),
+    /// A wider filter: the samples splatted over the tile and the pixels around it.
+    Splats(Film),
+}
+
 /// What one tile's render produced in one pass.
 struct TileResult<S, O> {
     rect: PixelRect,
-    /// Row-major, `rect`'s width per row: the mean of the pass's samples.
-    pixels: Vec<[f32; 3]>,
+    samples: TileSamples,
     /// Work per camera sample, per pixel.
     work: Vec<f32>,
     counts: RayCounts,
@@ -152,14 +159,16 @@ fn render_passes<I: SampleIntegrator>(
 ) -> RenderOutput<<I::Tile as TileState>::Stats> {
     let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
     let region = settings.crop.unwrap_or(PixelRect::whole(width, height));
+    // A filter wider than a pixel needs the samples of the pixels around the region too.
+    let rendered = region.grown(world.filter.margin(), (width, height));
     let rects: Vec<PixelRect> = tiles(width, height)
         .iter()
-        .filter_map(|tile| tile.intersection(&region))
+        .filter_map(|tile| tile.intersection(&rendered))
         .collect();
     let mut passes = integrator.passes(settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
-    let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(region);
+    let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(region, rendered);
     let mut index = 0;
     while index < passes.len() {
         let samples = passes[index];
@@ -196,7 +205,7 @@ fn render_passes<I: SampleIntegrator>(
     }
     progress.finish_and_clear();
     RenderOutput {
-        image: output.film.image(),
+        image: output.film.image_of(region),
         rays: output.rays,
         stats: output.stats,
         work_per_sample: output.work_per_sample,
@@ -214,9 +223,10 @@ struct Accumulated<S> {
 }
 
 impl<S: TileStats> Accumulated<S> {
-    fn new(region: PixelRect) -> Self {
+    /// Sums for the pixels of `region`, from the samples of the pixels of `rendered`.
+    fn new(region: PixelRect, rendered: PixelRect) -> Self {
         Accumulated {
-            film: Film::new(region.width(), region.height()),
+            film: Film::covering(rendered),
             rays: RayCounts::default(),
             stats: S::default(),
             work_per_sample: vec![0.0; region.area()],
@@ -229,11 +239,21 @@ impl<S: TileStats> Accumulated<S> {
         self.rays.merge(result.counts);
         self.stats.merge(result.stats);
         let rect = result.rect;
+        match &result.samples {
+            TileSamples::Means(means) => {
+                for ((x, y), &value) in rect.pixels().zip(means) {
+                    self.film.add_weighted(x, y, value, samples as f64);
+                }
+            }
+            TileSamples::Splats(film) => self.film.add_film(film),
+        }
         let share = samples as f32 / spp.max(1) as f32;
-        for (i, (value, work)) in result.pixels.into_iter().zip(result.work).enumerate() {
-            let x = rect.x0 + i % rect.width() - self.region.x0;
-            let y = rect.y0 + i / rect.width() - self.region.y0;
-            self.film.add_weighted(x, y, value, samples as f64);
+        for ((x, y), work) in rect.pixels().zip(result.work) {
+            // Pixels rendered around the region for a wide filter keep no work map.
+            if !self.region.contains(x, y) {
+                continue;
+            }
+            let (x, y) = (x - self.region.x0, y - self.region.y0);
             let slot = &mut self.work_per_sample[y * self.region.width() + x];
             *slot = if samples == spp {
                 work
@@ -257,15 +277,18 @@ fn render_tile<I: SampleIntegrator>(
     let mut state = integrator.begin_tile(world, tile, learned, &mut counts);
     let (width, height) = tile.image;
     let spp = pass.samples;
-    let mut pixels = Vec::with_capacity(tile.rect.area());
+    let filter = world.filter;
+    let mut means = Vec::with_capacity(tile.rect.area());
+    let mut splats = (filter != ReconstructionFilter::Box)
+        .then(|| Film::covering(tile.rect.grown(filter.margin(), tile.image)));
     let mut work = Vec::with_capacity(tile.rect.area());
     for (x, y) in tile.rect.pixels() {
         let mut rng = Pcg32::new(pass.pixel_seed(tile.seed, x, y, width), 0);
         let work_before = state.work();
         let mut sum = [0.0f64; 3];
         for _ in 0..spp {
-            let u = (x as f32 + rng.next_f32()) / width as f32;
-            let v = (y as f32 + rng.next_f32()) / height as f32;
+            let position = [x as f32 + rng.next_f32(), y as f32 + rng.next_f32()];
+            let (u, v) = (position[0] / width as f32, position[1] / height as f32);
             let ray = if world.camera.has_aperture() {
                 world
                     .camera
@@ -274,17 +297,22 @@ fn render_tile<I: SampleIntegrator>(
                 world.camera.ray(u, v)
             };
             let value = integrator.radiance(world, &ray, &mut rng, &mut state, &mut counts);
-            for (s, c) in sum.iter_mut().zip(value) {
-                *s += c as f64;
+            match splats.as_mut() {
+                Some(film) => film.splat(&filter, position, value),
+                None => {
+                    for (s, c) in sum.iter_mut().zip(value) {
+                        *s += c as f64;
+                    }
+                }
             }
         }
-        pixels.push(sum.map(|s| (s / spp as f64) as f32));
+        means.push(sum.map(|s| (s / spp as f64) as f32));
         work.push((state.work() - work_before) as f32 / spp as f32);
     }
     let observed = state.take_observed();
     TileResult {
         rect: tile.rect,
-        pixels,
+        samples: splats.map_or(TileSamples::Means(means), TileSamples::Splats),
         work,
         counts,
         stats: state.finish(),

@@ -77,6 +77,21 @@ impl PixelRect {
         })
     }
 
+    /// Whether pixel (x, y) is in it.
+    pub fn contains(&self, x: usize, y: usize) -> bool {
+        (self.x0..self.x1).contains(&x) && (self.y0..self.y1).contains(&y)
+    }
+
+    /// It and `margin` pixels around it, within a `width × height` image.
+    pub fn grown(&self, margin: usize, (width, height): (usize, usize)) -> PixelRect {
+        PixelRect {
+            x0: self.x0.saturating_sub(margin),
+            y0: self.y0.saturating_sub(margin),
+            x1: (self.x1 + margin).min(width),
+            y1: (self.y1 + margin).min(height),
+        }
+    }
+
     /// Its pixels, row by row.
     pub fn pixels(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
         (self.y0..self.y1).flat_map(move |y| (self.x0..self.x1).map(move |x| (x, y)))

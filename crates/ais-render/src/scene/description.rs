@@ -4,6 +4,7 @@ use super::file_resolver::FileResolver;
 use super::properties::Plugin;
 use super::xml;
 use crate::error::InputError;
+use crate::film::ReconstructionFilter;
 use glam::{DMat4, DVec3};
 use std::path::{Path, PathBuf};
 
@@ -158,6 +159,8 @@ pub struct SceneDescription {
     pub camera: CameraDescription,
     /// Film width and height in pixels.
     pub resolution: (u32, u32),
+    /// The film's reconstruction filter (Mitsuba's default: a Gaussian of σ = ½ pixel).
+    pub filter: ReconstructionFilter,
     /// The sampler's `sample_count` (samples per pixel).
     pub sample_count: u32,
     /// Shapes.
@@ -208,6 +211,7 @@ pub fn parse_scene(
             fov_axis: FovAxis::X,
         },
         resolution: (768, 576),
+        filter: ReconstructionFilter::MITSUBA_DEFAULT,
         sample_count: 4,
         shapes: Vec::new(),
         bsdfs: Vec::new(),
@@ -327,7 +331,9 @@ fn read_sensor(
     }
     for child in parts {
         match child.tag.as_str() {
-            "film" => scene.resolution = read_film(path, child, &mut scene.warnings)?,
+            "film" => {
+                (scene.resolution, scene.filter) = read_film(path, child, &mut scene.warnings)?
+            }
             "sampler" => {
                 warn_unknown(path, child, &["sample_count", "seed"], &mut scene.warnings);
                 let count = child.integer("sample_count", 4)?;
@@ -443,13 +449,12 @@ fn read_lens(sensor: &Plugin) -> Result<ThinLens, (u32, String)> {
     })
 }
 
-/// The size of an `hdrfilm`; its reconstruction filter is replaced by a box (with a
-/// warning for any other).
+/// The size and reconstruction filter of an `hdrfilm`.
 fn read_film(
     path: &Path,
     film: &Plugin,
     warnings: &mut Vec<String>,
-) -> Result<(u32, u32), (u32, String)> {
+) -> Result<((u32, u32), ReconstructionFilter), (u32, String)> {
     if film.kind != "hdrfilm" {
         return Err((
             film.line,
@@ -480,17 +485,54 @@ fn read_film(
             film.line
         ));
     }
-    for filter in &film.children {
-        if filter.kind != "box" {
-            warnings.push(format!(
-                "{}:{}: reconstruction filter \"{}\" replaced by a box filter",
-                path.display(),
-                filter.line,
-                filter.kind
-            ));
-        }
+    let mut filter = ReconstructionFilter::MITSUBA_DEFAULT;
+    for child in film.children.iter().filter(|c| c.tag == "rfilter") {
+        filter = read_filter(path, child, warnings)?;
     }
-    Ok((width as u32, height as u32))
+    Ok(((width as u32, height as u32), filter))
+}
+
+/// A film's `<rfilter>`: `box`, `tent` (`radius`, default 1) or `gaussian` (`stddev`,
+/// default ½); any other type is replaced by Mitsuba's default Gaussian, with a warning.
+fn read_filter(
+    path: &Path,
+    filter: &Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<ReconstructionFilter, (u32, String)> {
+    let (read, known): (_, &[&str]) = match filter.kind.as_str() {
+        "box" => (ReconstructionFilter::Box, &[]),
+        "tent" => {
+            let radius = positive_filter_size(filter, "radius", 1.0)?;
+            (ReconstructionFilter::Tent { radius }, &["radius"])
+        }
+        "gaussian" => {
+            let stddev = positive_filter_size(filter, "stddev", 0.5)?;
+            (ReconstructionFilter::Gaussian { stddev }, &["stddev"])
+        }
+        other => {
+            warnings.push(format!(
+                "{}:{}: reconstruction filter \"{other}\" replaced by a Gaussian of σ = ½ \
+                 pixel (Mitsuba's default)",
+                path.display(),
+                filter.line
+            ));
+            return Ok(ReconstructionFilter::MITSUBA_DEFAULT);
+        }
+    };
+    warn_unknown(path, filter, known, warnings);
+    Ok(read)
+}
+
+/// A filter's size property, in (0, 16] pixels.
+fn positive_filter_size(filter: &Plugin, name: &str, default: f64) -> Result<f32, (u32, String)> {
+    let value = filter.float(name, default)?;
+    if !(value > 0.0 && value <= 16.0) {
+        return Err((
+            filter.line,
+            format!("rfilter {name} must lie in (0, 16] pixels, got {value}"),
+        ));
+    }
+    Ok(value as f32)
 }
 
 fn read_shape(

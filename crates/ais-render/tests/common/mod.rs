@@ -101,12 +101,13 @@ pub fn scene_world(name: &str, xml: &str, files: &[(&str, &str)]) -> World {
     World::from_description(load_scene(&path, &[]).unwrap()).unwrap()
 }
 
-/// A perspective sensor at `origin` looking at `target` (z up), square film of `size`.
+/// A perspective sensor at `origin` looking at `target` (z up), square film of `size`,
+/// box-filtered so that the statistical tests' pixels are independent samples.
 pub fn camera(origin: &str, target: &str, fov: f64, size: u32) -> String {
     format!(
         r#"<sensor type="perspective"><float name="fov" value="{fov}"/>
         <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0, 0, 1"/></transform>
-        <film type="hdrfilm"><integer name="width" value="{size}"/><integer name="height" value="{size}"/></film></sensor>"#
+        <film type="hdrfilm"><integer name="width" value="{size}"/><integer name="height" value="{size}"/><rfilter type="box"/></film></sensor>"#
     )
 }
 
