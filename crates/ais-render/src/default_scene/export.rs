@@ -104,6 +104,57 @@ fn colour(v: Vec3) -> String {
 /// The scene file. Emitters carry Mitsuba's default diffuse BSDF, as the built-in scene's
 /// do, so that both are the same scene.
 fn scene_xml() -> String {
+    format!(
+        r#"<?xml version="1.0" encoding="utf-8"?>
+<!-- ais's built-in default scene, written by `ais export-default`: a grooved sculpture of
+     408,576 triangles on a ground plane, under a procedural sky with a sun, two sphere
+     lights and a rectangle light. Direct light only. -->
+<scene version="3.0.0">
+    <default name="spp" value="4"/>
+    <default name="res_x" value="640"/>
+    <default name="res_y" value="360"/>
+
+    <integrator type="direct"/>
+{sensor}
+    <emitter type="envmap">
+        <string name="filename" value="{SKY_FILE}"/>
+    </emitter>
+{shapes}
+</scene>
+"#,
+        sensor = sensor_xml(),
+        shapes = shapes_xml(),
+    )
+}
+
+/// The camera, with a box-filtered film as the built-in scene has.
+fn sensor_xml() -> String {
+    format!(
+        r#"
+    <sensor type="perspective">
+        <float name="fov" value="{fov}"/>
+        <string name="fov_axis" value="x"/>
+        <transform name="to_world">
+            <lookat origin="{origin}" target="{target}" up="0, 1, 0"/>
+        </transform>
+        <film type="hdrfilm">
+            <integer name="width" value="$res_x"/>
+            <integer name="height" value="$res_y"/>
+            <rfilter type="box"/>
+        </film>
+        <sampler type="independent">
+            <integer name="sample_count" value="$spp"/>
+        </sampler>
+    </sensor>
+"#,
+        fov = CAMERA_FOV_X_DEGREES,
+        origin = dvec(CAMERA_ORIGIN),
+        target = dvec(CAMERA_TARGET),
+    )
+}
+
+/// The sculpture, the ground, the rectangle light and the sphere lights.
+fn shapes_xml() -> String {
     let spheres: String = SPHERE_LIGHTS
         .iter()
         .map(|light| {
@@ -122,37 +173,7 @@ fn scene_xml() -> String {
         })
         .collect();
     format!(
-        r#"<?xml version="1.0" encoding="utf-8"?>
-<!-- ais's built-in default scene, written by `ais export-default`: a grooved sculpture of
-     408,576 triangles on a ground plane, under a procedural sky with a sun, two sphere
-     lights and a rectangle light. Direct light only. -->
-<scene version="3.0.0">
-    <default name="spp" value="4"/>
-    <default name="res_x" value="640"/>
-    <default name="res_y" value="360"/>
-
-    <integrator type="direct"/>
-
-    <sensor type="perspective">
-        <float name="fov" value="{fov}"/>
-        <string name="fov_axis" value="x"/>
-        <transform name="to_world">
-            <lookat origin="{camera_origin}" target="{camera_target}" up="0, 1, 0"/>
-        </transform>
-        <film type="hdrfilm">
-            <integer name="width" value="$res_x"/>
-            <integer name="height" value="$res_y"/>
-            <rfilter type="box"/>
-        </film>
-        <sampler type="independent">
-            <integer name="sample_count" value="$spp"/>
-        </sampler>
-    </sensor>
-
-    <emitter type="envmap">
-        <string name="filename" value="{SKY_FILE}"/>
-    </emitter>
-
+        r#"
     <shape type="ply">
         <string name="filename" value="{SCULPTURE_FILE}"/>
         <bsdf type="diffuse"><rgb name="reflectance" value="{sculpture_albedo}"/></bsdf>
@@ -175,12 +196,7 @@ fn scene_xml() -> String {
         <bsdf type="diffuse"/>
         <emitter type="area"><rgb name="radiance" value="{panel_radiance}"/></emitter>
     </shape>
-{spheres}
-</scene>
-"#,
-        fov = CAMERA_FOV_X_DEGREES,
-        camera_origin = dvec(CAMERA_ORIGIN),
-        camera_target = dvec(CAMERA_TARGET),
+{spheres}"#,
         sculpture_albedo = colour(SCULPTURE_ALBEDO),
         ground_albedo = colour(GROUND_ALBEDO),
         panel_origin = dvec(PANEL_ORIGIN),

@@ -235,20 +235,13 @@ pub fn default_world(width: u32, height: u32) -> World {
         Material::default(),
     ];
     let camera_description = default_camera();
+    let name = std::path::Path::new(crate::request::BUILT_IN_NAME);
+    let files = crate::scene::FileResolver::new(std::path::Path::new("."), &[]);
     let description = SceneDescription {
-        file: crate::request::BUILT_IN_NAME.into(),
         camera: camera_description.clone(),
         resolution: (width, height),
         filter: ReconstructionFilter::Box,
-        sample_count: 4,
-        shapes: Vec::new(),
-        bsdfs: Vec::new(),
-        textures: Vec::new(),
-        referable: Vec::new(),
-        emitters: Vec::new(),
-        integrator: None,
-        warnings: Vec::new(),
-        files: crate::scene::FileResolver::new(std::path::Path::new("."), &[]),
+        ..SceneDescription::empty(name, files)
     };
     World {
         geometry,

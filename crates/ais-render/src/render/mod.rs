@@ -161,10 +161,7 @@ fn render_passes<I: SampleIntegrator>(
     let region = settings.crop.unwrap_or(PixelRect::whole(width, height));
     // A filter wider than a pixel needs the samples of the pixels around the region too.
     let rendered = region.grown(world.filter.margin(), (width, height));
-    let rects: Vec<PixelRect> = tiles(width, height)
-        .iter()
-        .filter_map(|tile| tile.intersection(&rendered))
-        .collect();
+    let rects = tiles_of(rendered, (width, height));
     let mut passes = integrator.passes(settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
@@ -211,6 +208,15 @@ fn render_passes<I: SampleIntegrator>(
         work_per_sample: output.work_per_sample,
         time: started.elapsed(),
     }
+}
+
+/// The tiles of a `size` image that hold pixels of `rendered`, cut to it (each keeps its
+/// place in the whole image's grid).
+fn tiles_of(rendered: PixelRect, (width, height): (usize, usize)) -> Vec<PixelRect> {
+    tiles(width, height)
+        .iter()
+        .filter_map(|tile| tile.intersection(&rendered))
+        .collect()
 }
 
 /// The passes' results so far, over the rendered region.

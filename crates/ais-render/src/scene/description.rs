@@ -182,6 +182,35 @@ pub struct SceneDescription {
     pub warnings: Vec<String>,
 }
 
+impl SceneDescription {
+    /// A scene of nothing, with Mitsuba's defaults for what a file leaves out: its default
+    /// sensor (fov 39.3077° along x at the origin), a 768 × 576 film with the Gaussian
+    /// filter, and 4 samples per pixel.
+    pub fn empty(file: &Path, files: FileResolver) -> Self {
+        SceneDescription {
+            file: file.to_path_buf(),
+            camera: CameraDescription {
+                to_world: DMat4::IDENTITY,
+                projection: Projection::Perspective,
+                lens: None,
+                fov_degrees: 39.3077,
+                fov_axis: FovAxis::X,
+            },
+            resolution: (768, 576),
+            filter: ReconstructionFilter::MITSUBA_DEFAULT,
+            sample_count: 4,
+            shapes: Vec::new(),
+            bsdfs: Vec::new(),
+            textures: Vec::new(),
+            referable: Vec::new(),
+            emitters: Vec::new(),
+            integrator: None,
+            warnings: Vec::new(),
+            files,
+        }
+    }
+}
+
 /// Reads a Mitsuba 3 XML scene file. `overrides` set `$param` values (`-D name=value`).
 pub fn load_scene(
     path: &Path,
@@ -202,25 +231,8 @@ pub fn parse_scene(
 ) -> Result<SceneDescription, InputError> {
     let parsed = xml::parse(path, text, overrides)?;
     let mut scene = SceneDescription {
-        file: path.to_path_buf(),
-        camera: CameraDescription {
-            to_world: DMat4::IDENTITY,
-            projection: Projection::Perspective,
-            lens: None,
-            fov_degrees: 39.3077,
-            fov_axis: FovAxis::X,
-        },
-        resolution: (768, 576),
-        filter: ReconstructionFilter::MITSUBA_DEFAULT,
-        sample_count: 4,
-        shapes: Vec::new(),
-        bsdfs: Vec::new(),
-        textures: Vec::new(),
-        referable: Vec::new(),
-        emitters: Vec::new(),
-        integrator: None,
         warnings: parsed.warnings,
-        files: FileResolver::new(path, &parsed.paths),
+        ..SceneDescription::empty(path, FileResolver::new(path, &parsed.paths))
     };
     let files = scene.files.clone();
     // BSDFs and textures first so that shapes may reference ones declared after them.
