@@ -3,7 +3,7 @@
 //! renderer.
 
 use super::guiding::CandidateSampler;
-use super::light::{free_radiance, Leaving};
+use super::light::{free_radiance, Leaving, ShadowRay};
 use super::settings::{GatherSettings, MapUse};
 use super::strategy::GatherPoint;
 use crate::lights::{luminance, Toward};
@@ -90,9 +90,10 @@ pub fn run_batch<P: BatchProbe>(
     let at = run.at;
     probe.started();
     batch.begin(run.settings.rays, run.seed, run.start);
-    // Without a map, observations or a recorder, nothing reads what a traced ray saw
-    // besides its value: a blocked ray can skip the lookups its value would need.
-    let value_only = batch.map().is_none() && batch.observations().is_none() && recorder.is_none();
+    // Without a map or observations, nothing reads what a traced ray saw but its value and
+    // (for a recorder) whether it was free: a blocked ray can skip the lookups its value
+    // would need.
+    let value_only = batch.map().is_none() && batch.observations().is_none();
     let mut values = RunningMean::default();
     while let Some(candidate) = batch.next_candidate() {
         let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
@@ -107,8 +108,12 @@ pub fn run_batch<P: BatchProbe>(
         if let Decision::Trace { .. } = decision {
             let started = run.clock.map(|_| Instant::now());
             let (value, rating) = if value_only && known.is_none() {
+                let (value, free) = traced_value(run, toward, counts);
+                if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), free) {
+                    recorder.record(direction.into(), free);
+                }
                 // Nothing reads the rating: the batch has no map to learn.
-                (traced_value(run, toward, counts), 0.0)
+                (value, 0.0)
             } else {
                 let (value, seen) = trace(run, toward, known, counts);
                 if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), seen.free()) {
@@ -211,18 +216,25 @@ impl Seen {
 
 /// Traces an accepted candidate whose value alone is wanted: its contribution f·L/p, with
 /// the density, the BSDF and the environment's radiance looked up only if its shadow ray is
-/// free. The same value as [`trace`] gives.
-fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> Vec3 {
+/// free (the same value as [`trace`] gives), and whether a ray toward light was free (None:
+/// none was traced, or it brought nothing).
+fn traced_value(
+    run: &BatchRun,
+    mut toward: Toward,
+    counts: &mut RayCounts,
+) -> (Vec3, Option<bool>) {
     let at = run.at;
-    let Some(radiance) = free_radiance(run.world, at, &mut toward, counts) else {
-        return Vec3::ZERO;
+    let radiance = match free_radiance(run.world, at, &mut toward, counts) {
+        ShadowRay::Unneeded => return (Vec3::ZERO, None),
+        ShadowRay::Blocked => return (Vec3::ZERO, Some(false)),
+        ShadowRay::Free(radiance) => radiance,
     };
     let pdf = run.sampler.pdf(at, &mut toward);
     // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 || radiance == Vec3::ZERO {
-        return Vec3::ZERO;
+        return (Vec3::ZERO, None);
     }
-    at.scattering(&toward) * radiance / pdf as f32
+    (at.scattering(&toward) * radiance / pdf as f32, Some(true))
 }
 
 /// Traces an accepted candidate: its contribution f·L/p and what it saw.

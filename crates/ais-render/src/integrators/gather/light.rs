@@ -56,19 +56,29 @@ fn shadow_ray(at: &GatherPoint, direction: Vec3, target: Option<Vec3>) -> Ray {
     }
 }
 
-/// The radiance a candidate brings if its shadow ray is free: `None` when the ray is
-/// blocked, or when it surely brings nothing (then no ray is traced). The ray is traced
-/// before the radiance is looked up (for the environment, a texture lookup), which a
-/// blocked ray does not need. A ray toward a black part of the environment is traced
-/// (and counted), where [`Leaving`] would know not to.
+/// What a candidate's shadow ray found ([`free_radiance`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadowRay {
+    /// No ray was traced: the candidate surely brings nothing.
+    Unneeded,
+    /// Something blocks it.
+    Blocked,
+    /// It is free, and brings this radiance (zero toward a black part of the environment).
+    Free(Vec3),
+}
+
+/// The radiance a candidate brings if its shadow ray is free. The ray is traced before the
+/// radiance is looked up (for the environment, a texture lookup), which a blocked ray does
+/// not need; so a ray toward a black part of the environment is traced (and counted),
+/// where [`Leaving`] would know not to.
 pub fn free_radiance(
     world: &World,
     at: &GatherPoint,
     toward: &mut Toward,
     counts: &mut RayCounts,
-) -> Option<Vec3> {
+) -> ShadowRay {
     let target = match world.lights.aim(&at.receiver, toward) {
-        Aim::Nothing => return None,
+        Aim::Nothing => return ShadowRay::Unneeded,
         Aim::Point(target) => Some(target),
         Aim::Unbounded => None,
     };
@@ -77,9 +87,9 @@ pub fn free_radiance(
         .geometry
         .occluded(&shadow_ray(at, toward.direction, target))
     {
-        return None;
+        return ShadowRay::Blocked;
     }
-    Some(world.lights.unoccluded(&at.receiver, toward).0)
+    ShadowRay::Free(world.lights.unoccluded(&at.receiver, toward).0)
 }
 
 /// Light arriving at the gather point from a candidate direction, occluders included:
