@@ -107,25 +107,19 @@ pub fn run_batch<P: BatchProbe>(
         let (decision, known) = decide(run, batch, &mut values, &mut toward, in_support);
         if let Decision::Trace { .. } = decision {
             let started = run.clock.map(|_| Instant::now());
-            let (value, rating) = if value_only && known.is_none() {
-                let (value, free) = traced_value(run, toward, counts);
-                if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), free) {
-                    recorder.record(direction.into(), free);
-                }
-                // Nothing reads the rating: the batch has no map to learn.
-                (value, 0.0)
+            let traced = if value_only && known.is_none() {
+                traced_value(run, toward, counts)
             } else {
-                let (value, seen) = trace(run, toward, known, counts);
-                if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), seen.free()) {
-                    recorder.record(direction.into(), free);
-                }
-                (value, seen.rating)
+                trace(run, toward, known, counts)
             };
-            batch.record(value.to_array(), rating);
+            if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), traced.free) {
+                recorder.record(direction.into(), free);
+            }
+            batch.record(traced.value.to_array(), traced.rating);
             if let (Some(clock), Some(started)) = (run.clock, started) {
                 clock.set(clock.get() + started.elapsed());
             }
-            probe.recorded(batch, value.to_array(), rating);
+            probe.recorded(batch, traced.value.to_array(), traced.rating);
         }
     }
     let estimate = batch.finish();
@@ -199,42 +193,43 @@ fn unoccluded_value(run: &BatchRun, toward: &mut Toward) -> (f32, Known) {
     (value, Known { density, leaving })
 }
 
-/// What a traced candidate saw, for the batch and the field.
-struct Seen {
-    /// Actual over unoccluded radiance, in [0, 1].
+/// What a traced candidate brought and saw, for the batch and the field.
+struct Traced {
+    /// Its contribution f·L/p.
+    value: Vec3,
+    /// Actual over unoccluded radiance, in [0, 1] (0 where nothing reads it).
     rating: f32,
-    /// Whether a ray was traced toward light (a candidate bringing nothing is not traced).
-    traced: bool,
+    /// Whether its ray toward light was free (None: no such ray was traced, or it brought
+    /// nothing).
+    free: Option<bool>,
 }
 
-impl Seen {
-    /// Whether the ray was free, if one was traced.
-    fn free(&self) -> Option<bool> {
-        self.traced.then_some(self.rating > 0.0)
-    }
-}
-
-/// Traces an accepted candidate whose value alone is wanted: its contribution f·L/p, with
-/// the density, the BSDF and the environment's radiance looked up only if its shadow ray is
-/// free (the same value as [`trace`] gives), and whether a ray toward light was free (None:
-/// none was traced, or it brought nothing).
-fn traced_value(
-    run: &BatchRun,
-    mut toward: Toward,
-    counts: &mut RayCounts,
-) -> (Vec3, Option<bool>) {
+/// Traces an accepted candidate whose value alone is wanted (with whether its ray was
+/// free, for a recorder): the density, the BSDF and the environment's radiance are looked
+/// up only if its shadow ray is free. The same value as [`trace`] gives; the rating is 0,
+/// as nothing reads it (the batch has no map to learn).
+fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> Traced {
     let at = run.at;
+    let nothing = |free| Traced {
+        value: Vec3::ZERO,
+        rating: 0.0,
+        free,
+    };
     let radiance = match free_radiance(run.world, at, &mut toward, counts) {
-        ShadowRay::Unneeded => return (Vec3::ZERO, None),
-        ShadowRay::Blocked => return (Vec3::ZERO, Some(false)),
+        ShadowRay::Unneeded => return nothing(None),
+        ShadowRay::Blocked => return nothing(Some(false)),
         ShadowRay::Free(radiance) => radiance,
     };
     let pdf = run.sampler.pdf(at, &mut toward);
     // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 || radiance == Vec3::ZERO {
-        return (Vec3::ZERO, None);
+        return nothing(None);
     }
-    (at.scattering(&toward) * radiance / pdf as f32, Some(true))
+    Traced {
+        value: at.scattering(&toward) * radiance / pdf as f32,
+        rating: 0.0,
+        free: Some(true),
+    }
 }
 
 /// Traces an accepted candidate: its contribution f·L/p and what it saw.
@@ -243,7 +238,7 @@ fn trace(
     mut toward: Toward,
     known: Option<Known>,
     counts: &mut RayCounts,
-) -> (Vec3, Seen) {
+) -> Traced {
     let at = run.at;
     let Known {
         density: pdf,
@@ -254,18 +249,18 @@ fn trace(
     });
     // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 {
-        let nothing = Seen {
+        return Traced {
+            value: Vec3::ZERO,
             rating: rating(0.0, 0.0),
-            traced: false,
+            free: None,
         };
-        return (Vec3::ZERO, nothing);
     }
-    let traced = leaving.unoccluded != Vec3::ZERO;
     let actual = leaving.trace(run.world, counts);
-    let value = at.scattering(&toward) * actual / pdf as f32;
-    let seen = Seen {
-        rating: rating(luminance(actual), luminance(leaving.unoccluded)),
-        traced,
-    };
-    (value, seen)
+    let rating = rating(luminance(actual), luminance(leaving.unoccluded));
+    Traced {
+        value: at.scattering(&toward) * actual / pdf as f32,
+        rating,
+        // A ray was traced toward light only if it could bring some.
+        free: (leaving.unoccluded != Vec3::ZERO).then_some(rating > 0.0),
+    }
 }
