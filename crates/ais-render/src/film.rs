@@ -21,7 +21,8 @@ pub enum ReconstructionFilter {
         radius: f32,
     },
     /// Mitsuba's `gaussian` (its default): exp(−x² / 2σ²) − exp(−r² / 2σ²), clipped at 0,
-    /// along each axis, with radius r = 4σ.
+    /// along each axis, with radius r = 4σ. Filters reach at most 16 pixels (the scene
+    /// reader refuses wider ones; a wider one's outer weights are dropped).
     Gaussian {
         /// σ in pixels.
         stddev: f32,
@@ -115,21 +116,13 @@ impl Film {
     /// Adds a sample at image position `position` (pixels; pixel (x, y) spans [x, x + 1) ×
     /// [y, y + 1)) to the covered pixels within `filter`'s reach.
     pub fn splat(&mut self, filter: &ReconstructionFilter, position: [f32; 2], value: [f32; 3]) {
-        let radius = filter.radius();
-        let span = |p: f32, low: usize, high: usize| {
-            // Pixels whose centres i + ½ lie within the radius of p.
-            let first = (p - 0.5 - radius).ceil().max(low as f32) as usize;
-            let last = ((p - 0.5 + radius).floor() as i64).min(high as i64 - 1);
-            (first, last)
-        };
-        let (x_first, x_last) = span(position[0], self.rect.x0, self.rect.x1);
-        let (y_first, y_last) = span(position[1], self.rect.y0, self.rect.y1);
-        for y in y_first as i64..=y_last {
-            let wy = filter.eval(y as f32 + 0.5 - position[1]);
-            for x in x_first as i64..=x_last {
-                let weight = wy * filter.eval(x as f32 + 0.5 - position[0]);
+        let columns = AxisWeights::new(filter, position[0], self.rect.x0, self.rect.x1);
+        let rows = AxisWeights::new(filter, position[1], self.rect.y0, self.rect.y1);
+        for (y, &wy) in rows.pixels() {
+            for (x, &wx) in columns.pixels() {
+                let weight = wy * wx;
                 if weight > 0.0 {
-                    self.add_weighted(x as usize, y as usize, value, weight as f64);
+                    self.add_weighted(x, y, value, weight as f64);
                 }
             }
         }
@@ -178,6 +171,40 @@ impl Film {
     }
 }
 
+/// The most pixels a filter reaches along one axis (radius at most 16: 33 pixels).
+const MOST_REACHED: usize = 34;
+
+/// A filter's weights along one axis for a sample at `p`: the pixels whose centres lie
+/// within its radius, in `[low, high)`, each weighed once for all the rows or columns.
+struct AxisWeights {
+    first: usize,
+    weights: [f32; MOST_REACHED],
+    count: usize,
+}
+
+impl AxisWeights {
+    fn new(filter: &ReconstructionFilter, p: f32, low: usize, high: usize) -> Self {
+        let radius = filter.radius();
+        let first = (p - 0.5 - radius).ceil().max(low as f32) as usize;
+        let last = ((p - 0.5 + radius).floor() as i64).min(high as i64 - 1);
+        let count = (last + 1 - first as i64).clamp(0, MOST_REACHED as i64) as usize;
+        let mut weights = [0.0; MOST_REACHED];
+        for (i, weight) in weights.iter_mut().take(count).enumerate() {
+            *weight = filter.eval((first + i) as f32 + 0.5 - p);
+        }
+        AxisWeights {
+            first,
+            weights,
+            count,
+        }
+    }
+
+    /// The pixels reached, with their weights.
+    fn pixels(&self) -> impl Iterator<Item = (usize, &f32)> {
+        (self.first..).zip(&self.weights[..self.count])
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -215,6 +242,18 @@ mod tests {
             assert!((image.pixels[y * 4 + x][0] - 3.0).abs() < 1e-6);
         }
         assert_eq!(image.pixels.iter().filter(|p| p[0] != 0.0).count(), 4);
+    }
+
+    #[test]
+    fn the_widest_tent_reaches_every_pixel_within_16() {
+        let filter = ReconstructionFilter::Tent { radius: 16.0 };
+        let mut film = Film::new(40, 1);
+        film.splat(&filter, [20.3, 0.5], [1.0; 3]);
+        let reached = film.weights.iter().filter(|&&w| w > 0.0).count();
+        // The centres 4.5 … 35.5 lie within 16 of 20.3.
+        assert_eq!(reached, 32, "{:?}", film.weights);
+        assert!(film.weights[4] > 0.0 && film.weights[35] > 0.0);
+        assert!(film.weights[3] == 0.0 && film.weights[36] == 0.0);
     }
 
     #[test]

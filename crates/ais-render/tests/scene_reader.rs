@@ -183,6 +183,9 @@ fn reconstruction_filters_take_mitsubas_defaults() {
         warnings.join("\n").contains("property \"width\""),
         "{warnings:?}"
     );
+    // Mitsuba's Gaussian reaches 4σ: more than 16 pixels is refused.
+    let too_wide = read(r#"<rfilter type="gaussian"><float name="stddev" value="5"/></rfilter>"#);
+    assert!(too_wide.unwrap_err().to_string().contains("(0, 4]"));
     let bad = read(r#"<rfilter type="gaussian"><float name="stddev" value="0"/></rfilter>"#);
     let message = bad.unwrap_err().to_string();
     assert!(

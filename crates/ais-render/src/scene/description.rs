@@ -514,11 +514,12 @@ fn read_filter(
     let (read, known): (_, &[&str]) = match filter.kind.as_str() {
         "box" => (ReconstructionFilter::Box, &[]),
         "tent" => {
-            let radius = positive_filter_size(filter, "radius", 1.0)?;
+            let radius = positive_filter_size(filter, "radius", 1.0, 16.0)?;
             (ReconstructionFilter::Tent { radius }, &["radius"])
         }
         "gaussian" => {
-            let stddev = positive_filter_size(filter, "stddev", 0.5)?;
+            // Mitsuba cuts the Gaussian off at 4σ: a radius of at most 16 pixels.
+            let stddev = positive_filter_size(filter, "stddev", 0.5, 4.0)?;
             (ReconstructionFilter::Gaussian { stddev }, &["stddev"])
         }
         other => {
@@ -535,13 +536,18 @@ fn read_filter(
     Ok(read)
 }
 
-/// A filter's size property, in (0, 16] pixels.
-fn positive_filter_size(filter: &Plugin, name: &str, default: f64) -> Result<f32, (u32, String)> {
+/// A filter's size property, in (0, `most`] pixels.
+fn positive_filter_size(
+    filter: &Plugin,
+    name: &str,
+    default: f64,
+    most: f64,
+) -> Result<f32, (u32, String)> {
     let value = filter.float(name, default)?;
-    if !(value > 0.0 && value <= 16.0) {
+    if !(value > 0.0 && value <= most) {
         return Err((
             filter.line,
-            format!("rfilter {name} must lie in (0, 16] pixels, got {value}"),
+            format!("rfilter {name} must lie in (0, {most}] pixels, got {value}"),
         ));
     }
     Ok(value as f32)
