@@ -207,8 +207,15 @@ impl Lights {
     /// delta light's light and position.
     #[inline]
     pub fn unoccluded(&self, receiver: &Receiver, toward: &mut Toward) -> (Vec3, Option<Vec3>) {
+        let radiance = self.radiance_toward(receiver, toward);
+        (radiance, self.target(receiver, toward))
+    }
+
+    /// The radiance of [`Lights::unoccluded`] alone, without the point it comes from.
+    #[inline]
+    pub fn radiance_toward(&self, receiver: &Receiver, toward: &mut Toward) -> Vec3 {
         self.resolve(receiver, toward);
-        let radiance = match toward.source {
+        match toward.source {
             Source::Delta(_, arrival) => arrival.light,
             Source::Area(point) => point.radiance,
             Source::Environment => {
@@ -216,8 +223,7 @@ impl Lights {
                 environment.map_or(Vec3::ZERO, |e| e.radiance_toward(toward))
             }
             Source::Dark | Source::Unknown => Vec3::ZERO,
-        };
-        (radiance, self.target(receiver, toward))
+        }
     }
 
     /// Where the shadow ray of `toward` (resolved) must be free to: a finite point, or

@@ -312,7 +312,9 @@ fn render_tile<I: SampleIntegrator>(
                 }
             }
         }
-        means.push(sum.map(|s| (s / spp as f64) as f32));
+        if splats.is_none() {
+            means.push(sum.map(|s| (s / spp as f64) as f32));
+        }
         work.push((state.work() - work_before) as f32 / spp as f32);
     }
     let observed = state.take_observed();

@@ -89,7 +89,7 @@ pub fn free_radiance(
     {
         return ShadowRay::Blocked;
     }
-    ShadowRay::Free(world.lights.unoccluded(&at.receiver, toward).0)
+    ShadowRay::Free(world.lights.radiance_toward(&at.receiver, toward))
 }
 
 /// Light arriving at the gather point from a candidate direction, occluders included:
