@@ -8,6 +8,8 @@
 //!   takes the texel under (u W, v H); `wrap_mode` is `repeat` (default), `mirror` or `clamp`.
 //!   8-bit and 16-bit images are sRGB-encoded unless `raw` is true, and are converted to
 //!   linear once, when read; EXR and HDR images are linear.
+//! - Read as one channel (an opacity, a blend weight), a texture gives its colour's
+//!   luminance; a checkerboard's colours then swap places, as in Mitsuba 3.
 //! - `to_uv` transforms the coordinates first (its 2-D part: scale, rotation about z,
 //!   translation).
 
@@ -102,6 +104,33 @@ impl Texture {
             Texture::Bitmap(bitmap) => bitmap.eval(bitmap.to_uv.apply(uv)),
         }
     }
+
+    /// The texture read as one channel (an opacity, a blend weight), as Mitsuba 3 reads it:
+    /// the luminance of the colour, except that a checkerboard's one-channel lookup puts
+    /// `color0` where its colour lookup puts `color1` (and the reverse).
+    pub fn eval_scalar(&self, uv: Vec2) -> f32 {
+        let colour = match self {
+            Texture::Checkerboard {
+                color0,
+                color1,
+                to_uv,
+            } => {
+                let swapped = Texture::Checkerboard {
+                    color0: *color1,
+                    color1: *color0,
+                    to_uv: *to_uv,
+                };
+                return luminance(swapped.eval(uv));
+            }
+            Texture::Bitmap(bitmap) => bitmap.eval(bitmap.to_uv.apply(uv)),
+        };
+        luminance(colour)
+    }
+}
+
+/// Rec. 709 luminance of linear RGB (Mitsuba's one-channel reading of a colour).
+pub fn luminance(rgb: Vec3) -> f32 {
+    rgb.dot(Vec3::new(0.212_671, 0.715_160, 0.072_169))
 }
 
 impl Bitmap {

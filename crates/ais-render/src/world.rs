@@ -1,6 +1,6 @@
 //! A scene ready to render: geometry in a BVH, the camera, and the settings.
 
-use crate::bsdf::{albedo_texture, Material, TextureScene};
+use crate::bsdf::{read_surface, Material, Surface, TextureScene};
 use crate::camera::Camera;
 use crate::error::InputError;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
@@ -9,7 +9,6 @@ use crate::lights::{AreaLight, AreaShape, Emitters, Lights, Rectangle};
 use crate::mesh::{load_mesh, validate, TriangleMesh};
 use crate::scene::{self, SceneDescription};
 use crate::shapes;
-use crate::texture::Texture;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -28,10 +27,8 @@ pub struct World {
     pub sample_count: u32,
     /// The emitters.
     pub lights: Lights,
-    /// The material of each shape.
-    pub materials: Vec<Material>,
-    /// For each shape, the texture that gives its material's albedo at a hit, if any.
-    pub albedo_textures: Vec<Option<Arc<Texture>>>,
+    /// The scattering of each shape's surface.
+    pub surfaces: Vec<Arc<Surface>>,
     /// The description it was built from.
     pub description: SceneDescription,
     /// Warnings from reading the scene and its assets.
@@ -44,58 +41,44 @@ struct BuiltShape {
     light: Option<AreaLight>,
 }
 
-/// A shape's material: its BSDF or, as in Mitsuba, diffuse 0.5 without one, or black when it
-/// emits (so that a light does not also reflect the other lights).
-fn shape_material(
-    description: &SceneDescription,
-    shape: &scene::ShapeDescription,
-    warnings: &mut Vec<String>,
-) -> Result<Material, InputError> {
-    Ok(match shape.bsdf {
-        Some(index) => Material::from_plugin(
-            &description.bsdfs[index],
-            &description.file,
-            &description.bsdfs,
-            warnings,
-        )?,
-        None if shape.emitter.is_some() => Material::diffuse(Vec3::ZERO),
-        None => Material::default(),
-    })
-}
-
-/// The albedo textures of a scene's shapes, each BSDF's read once (and its image loaded
-/// once) however many shapes use it.
+/// The surfaces of a scene's shapes: each shape's BSDF or, as in Mitsuba, diffuse 0.5
+/// without one, or black when it emits (so that a light does not also reflect the other
+/// lights). Each BSDF is read once (its warnings given once, its images loaded once) however
+/// many shapes use it.
 #[derive(Default)]
-struct ShapeTextures {
-    per_shape: Vec<Option<Arc<Texture>>>,
-    by_bsdf: HashMap<usize, Option<Arc<Texture>>>,
+struct ShapeSurfaces {
+    per_shape: Vec<Arc<Surface>>,
+    by_bsdf: HashMap<usize, Arc<Surface>>,
 }
 
-impl ShapeTextures {
-    /// Adds the texture of `shape`'s BSDF, if it has one.
+impl ShapeSurfaces {
+    /// Adds the surface of `shape`.
     fn add(
         &mut self,
         description: &SceneDescription,
         shape: &scene::ShapeDescription,
         warnings: &mut Vec<String>,
     ) -> Result<(), InputError> {
-        let texture = match shape.bsdf {
-            Some(index) if !self.by_bsdf.contains_key(&index) => {
-                let scene = TextureScene {
-                    file: &description.file,
-                    files: &description.files,
-                    bsdfs: &description.bsdfs,
-                    textures: &description.textures,
-                };
-                let texture = albedo_texture(&description.bsdfs[index], &scene, warnings)?;
-                let texture = texture.map(Arc::new);
-                self.by_bsdf.insert(index, texture.clone());
-                texture
-            }
-            Some(index) => self.by_bsdf[&index].clone(),
-            None => None,
+        let surface = match shape.bsdf {
+            Some(index) => match self.by_bsdf.get(&index) {
+                Some(surface) => surface.clone(),
+                None => {
+                    let scene = TextureScene {
+                        file: &description.file,
+                        files: &description.files,
+                        bsdfs: &description.bsdfs,
+                        textures: &description.textures,
+                    };
+                    let surface = read_surface(&description.bsdfs[index], &scene, warnings)?;
+                    let surface = Arc::new(surface);
+                    self.by_bsdf.insert(index, surface.clone());
+                    surface
+                }
+            },
+            None if shape.emitter.is_some() => Arc::new(Material::diffuse(Vec3::ZERO).into()),
+            None => Arc::new(Material::default().into()),
         };
-        if texture.is_some() && rotated_sphere(shape) {
+        if surface.is_textured() && rotated_sphere(shape) {
             warnings.push(format!(
                 "{}:{}: a textured sphere's texture coordinates ignore the rotation in its \
                  to_world (they follow the world's axes)",
@@ -103,7 +86,7 @@ impl ShapeTextures {
                 shape.line
             ));
         }
-        self.per_shape.push(texture);
+        self.per_shape.push(surface);
         Ok(())
     }
 }
@@ -218,11 +201,9 @@ impl World {
         let file = description.file.clone();
         let mut inputs = Vec::with_capacity(description.shapes.len());
         let mut area_lights = Vec::new();
-        let mut materials = Vec::with_capacity(description.shapes.len());
-        let mut textures = ShapeTextures::default();
+        let mut surfaces = ShapeSurfaces::default();
         for (index, shape) in description.shapes.iter().enumerate() {
-            materials.push(shape_material(&description, shape, &mut warnings)?);
-            textures.add(&description, shape, &mut warnings)?;
+            surfaces.add(&description, shape, &mut warnings)?;
             let built = build_shape(&file, shape, index as u32, &mut warnings)?;
             inputs.push(built.input);
             area_lights.extend(built.light);
@@ -254,8 +235,7 @@ impl World {
         Ok(World {
             geometry,
             lights,
-            materials,
-            albedo_textures: textures.per_shape,
+            surfaces: surfaces.per_shape,
             camera: Camera::new(&description.camera, width, height),
             resolution: description.resolution,
             filter: description.filter,

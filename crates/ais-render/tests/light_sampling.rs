@@ -8,8 +8,8 @@ use ais::mapping::LatLong;
 use ais::rng::Pcg32;
 use ais::testing::{ChiSquareTest, Drawn};
 use ais_render::bsdf::{
-    Dielectric, Material, Microfacet, RoughDielectric, RoughPlastic, Scattering, ShadingFrame,
-    SmoothPlastic,
+    Dielectric, Fraction, Material, Microfacet, RoughDielectric, RoughPlastic, Scattering,
+    ShadingFrame, SmoothPlastic, Surface, SurfacePoint,
 };
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
@@ -166,14 +166,13 @@ fn environment_guided_by_an_affinity_map_fits() {
         0,
         10.0,
     );
-    let material = Material::default();
-    let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
-    let wo = Vec3::new(-0.3, 0.2, 1.0).normalize();
+    let surface = Surface::from(Material::default());
+    let (bsdf, frame) = surface.at(&surface_point());
     let at = GatherPoint {
         receiver: Receiver::guided(Vec3::ZERO, &guide),
-        frame: ShadingFrame::new(&material, normal, normal, wo),
-        wo,
-        material: std::borrow::Cow::Borrowed(&material),
+        frame,
+        wo: surface_point().wo,
+        bsdf,
         lights: &lights,
     };
     for (seed, strategy) in [(22, Strategy::Light), (23, Strategy::Mis)] {
@@ -342,18 +341,27 @@ fn light_selection_mixture_fits() {
     assert!(p > SIGNIFICANCE, "p = {p}");
 }
 
+/// A tilted surface seen obliquely, where the proposal tests gather.
+fn surface_point() -> SurfacePoint {
+    let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
+    SurfacePoint {
+        uv: glam::Vec2::ZERO,
+        shading_normal: normal,
+        geometric_normal: normal,
+        wo: Vec3::new(-0.3, 0.2, 1.0).normalize(),
+    }
+}
+
 #[test]
 fn every_gather_proposal_fits() {
     let lights = mixed_lights();
-    let material = Material::default();
-    let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
-    let wo = Vec3::new(-0.3, 0.2, 1.0).normalize();
-    let frame = ShadingFrame::new(&material, normal, normal, wo);
+    let surface = Surface::from(Material::default());
+    let (bsdf, frame) = surface.at(&surface_point());
     let at = GatherPoint {
         receiver: Receiver::new(Vec3::ZERO),
         frame,
-        wo,
-        material: std::borrow::Cow::Borrowed(&material),
+        wo: surface_point().wo,
+        bsdf,
         lights: &lights,
     };
     for (seed, strategy) in [
@@ -488,6 +496,61 @@ fn smooth_plastic_base_sampling_fits() {
     // which the base's density accounts for: it integrates to 1 − P(mirror).
     let material = smooth_plastic(Vec3::new(0.6, 0.3, 0.2));
     assert_sampling_fits(&material, 50, &views(), "smooth plastic");
+}
+
+/// A mask (opacity 0.6) over a blend (weight 0.3) of a rough plastic and a smooth plastic:
+/// continuous parts, point masses and light passing through, in one mixture.
+fn masked_blend() -> Surface {
+    Surface::Mask {
+        opacity: Fraction::Constant(0.6),
+        inner: Box::new(Surface::Blend {
+            weight: Fraction::Constant(0.3),
+            first: Box::new(plastic(0.2, Vec3::splat(0.5)).into()),
+            second: Box::new(smooth_plastic(Vec3::splat(0.8)).into()),
+        }),
+    }
+}
+
+#[test]
+fn mixture_sampling_fits_and_passes_light_through() {
+    for (k, (frame, wo)) in views().iter().enumerate() {
+        let point = SurfacePoint {
+            uv: glam::Vec2::ZERO,
+            shading_normal: frame.normal,
+            geometric_normal: frame.geometric,
+            wo: *wo,
+        };
+        let surface = masked_blend();
+        let (bsdf, _) = surface.at(&point);
+        let p = fit(
+            200_000,
+            40 + k as u64,
+            |u| Some(bsdf.sample(*wo, u)).filter(|s| s.1 > 0.0),
+            |d| bsdf.pdf(*wo, d),
+        );
+        assert!(p > SIGNIFICANCE, "view {k}: p = {p}");
+        // Light passes straight through 40% of the time, as a point mass of weight 0.4.
+        let mut rng = Pcg32::new(7 + k as u64, 1);
+        let draws = 100_000;
+        let through = (0..draws)
+            .filter_map(|_| bsdf.sample_lobe(*wo, [rng.next_f32(), rng.next_f32()]))
+            .filter(|s| s.direction == -*wo)
+            .inspect(|s| {
+                let mass = s.specular.expect("a point mass");
+                assert!((mass.weight - Vec3::splat(0.4)).abs().max_element() < 1e-6);
+                assert!((mass.probability - 0.4).abs() < 1e-6);
+            })
+            .count() as f64;
+        let share = through / draws as f64;
+        let se = (0.4f64 * 0.6 / draws as f64).sqrt();
+        assert!((share - 0.4).abs() < 4.0 * se, "view {k}: {share}");
+        // The mixture evaluates as its weighted parts.
+        let wi = frame.normal;
+        let expected = 0.6
+            * (0.7 * plastic(0.2, Vec3::splat(0.5)).eval(frame, *wo, wi)
+                + 0.3 * smooth_plastic(Vec3::splat(0.8)).eval(frame, *wo, wi));
+        assert!((bsdf.eval(*wo, wi) - expected).abs().max_element() < 1e-6);
+    }
 }
 
 fn rough_glass(microfacet: Microfacet) -> Material {

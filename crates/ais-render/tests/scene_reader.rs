@@ -426,14 +426,16 @@ fn textures_reach_the_albedo_and_warn_where_they_do_not() {
         <shape type="sphere"><transform name="to_world"><rotate x="1" angle="30"/></transform><ref id="d"/></shape>
     </scene>"#;
     let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
-    let board = world.albedo_textures[0]
-        .as_ref()
-        .expect("the diffuse is textured");
+    let albedo = |shape: usize| match world.surfaces[shape].as_ref() {
+        ais_render::bsdf::Surface::Material { albedo, .. } => albedo.clone(),
+        other => panic!("{other:?}"),
+    };
+    let board = albedo(0).expect("the diffuse is textured");
     assert_eq!(
         board.eval(glam::Vec2::new(0.1, 0.1)),
         glam::Vec3::splat(0.9)
     );
-    assert!(world.albedo_textures[1].is_none());
+    assert!(albedo(1).is_none());
     let warned = |want: &str| world.warnings.iter().any(|w| w.contains(want));
     assert!(
         warned("textures are not supported: specular_reflectance"),
@@ -568,4 +570,42 @@ fn a_spectrum_file_that_is_no_file_is_refused_before_it_is_read() {
     let text = "<scene><emitter type=\"constant\">\n<spectrum name=\"radiance\" filename=\"folder.spd\"/></emitter></scene>";
     let error = parse_scene(&scene, text, &[]).expect_err("a folder is no spectrum");
     assert!(error.to_string().contains("not a regular file"), "{error}");
+}
+
+#[test]
+fn masks_blends_and_null_are_read_and_checked() {
+    let shape = |bsdf: &str| {
+        format!("<scene version=\"3.0.0\">\n<shape type=\"rectangle\">\n{bsdf}\n</shape></scene>")
+    };
+    assert_world_refuses(
+        &shape(
+            r#"<bsdf type="blendbsdf"><float name="weight" value="0.5"/><bsdf type="diffuse"/></bsdf>"#,
+        ),
+        "test.xml:3: a \"blendbsdf\" holds two BSDFs, not 1",
+    );
+    assert_world_refuses(
+        &shape(r#"<bsdf type="blendbsdf"><bsdf type="diffuse"/><bsdf type="diffuse"/></bsdf>"#),
+        "test.xml:3: a \"blendbsdf\" needs its \"weight\"",
+    );
+    assert_world_refuses(
+        &shape(r#"<bsdf type="mask"><ref id="nowhere"/></bsdf>"#),
+        "test.xml:3: no <bsdf> with id \"nowhere\"",
+    );
+    let text = shape(
+        r#"<bsdf type="mask"><float name="opacity" value="1.5"/><float name="alpha" value="1"/>
+           <bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf>"#,
+    );
+    let world = ais_render::world::World::from_description(parse(&text).unwrap()).unwrap();
+    let warned = |want: &str| world.warnings.iter().any(|w| w.contains(want));
+    assert!(warned("test.xml:3: \"opacity\" = 1.5 is outside [0, 1]"));
+    assert!(warned(
+        "test.xml:3: property \"alpha\" of bsdf \"mask\" is ignored"
+    ));
+    match world.surfaces[0].as_ref() {
+        ais_render::bsdf::Surface::Mask { inner, .. } => assert!(matches!(
+            inner.as_ref(),
+            ais_render::bsdf::Surface::Material { material, .. } if material.two_sided
+        )),
+        other => panic!("{other:?}"),
+    }
 }

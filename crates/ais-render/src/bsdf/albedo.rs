@@ -59,14 +59,25 @@ pub fn albedo_texture(
     let Some(parameter) = albedo_parameter(&current.kind) else {
         return Ok(None);
     };
-    if let Some(child) = current
+    parameter_texture(current, parameter, scene, warnings)
+}
+
+/// The texture that gives `parameter` of `plugin`: a nested `<texture>` of that name, or a
+/// `<ref>` of that name to a top-level one.
+pub(super) fn parameter_texture(
+    plugin: &Plugin,
+    parameter: &str,
+    scene: &TextureScene,
+    warnings: &mut Vec<String>,
+) -> Result<Option<Texture>, InputError> {
+    if let Some(child) = plugin
         .children
         .iter()
         .find(|c| c.tag == "texture" && c.name.as_deref() == Some(parameter))
     {
         return read_texture(scene.file, scene.files, child, warnings).map(Some);
     }
-    let Some((_, id, line)) = current
+    let Some((_, id, line)) = plugin
         .references
         .iter()
         .find(|(name, _, _)| name.as_deref() == Some(parameter))

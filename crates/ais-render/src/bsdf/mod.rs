@@ -4,18 +4,24 @@
 
 mod albedo;
 mod conductors;
+mod hit;
 mod microfacet;
 mod reader;
 mod rough_dielectric;
 mod rough_plastic;
 mod specular;
+mod surface;
+mod surface_reader;
 
 pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
+pub use hit::{HitBsdf, Mixture, MixturePart};
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
+pub use surface::{Fraction, Surface, SurfacePoint};
+pub use surface_reader::read_surface;
 
 use crate::geometry::basis;
 use crate::scene::Plugin;
@@ -115,7 +121,17 @@ impl ShadingFrame {
         geometric_normal: Vec3,
         wo: Vec3,
     ) -> Self {
-        let flip = material.two_sided && geometric_normal.dot(wo) < 0.0;
+        Self::oriented(shading_normal, geometric_normal, wo, material.two_sided)
+    }
+
+    /// The frame at a hit seen from `wo`, turned toward the viewer if `two_sided`.
+    pub fn oriented(
+        shading_normal: Vec3,
+        geometric_normal: Vec3,
+        wo: Vec3,
+        two_sided: bool,
+    ) -> Self {
+        let flip = two_sided && geometric_normal.dot(wo) < 0.0;
         let (normal, geometric) = if flip {
             (-shading_normal, -geometric_normal)
         } else {

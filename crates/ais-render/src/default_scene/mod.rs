@@ -246,8 +246,10 @@ pub fn default_world(width: u32, height: u32) -> World {
     World {
         geometry,
         lights,
-        albedo_textures: vec![None; materials.len()],
-        materials,
+        surfaces: materials
+            .into_iter()
+            .map(|m| std::sync::Arc::new(m.into()))
+            .collect(),
         camera: Camera::new(&camera_description, width, height),
         resolution: (width, height),
         filter: ReconstructionFilter::Box,

@@ -151,7 +151,7 @@ impl Guide {
             let floor = map.min_affinity(0).max(GUIDE_FLOOR);
             guide.set_affinities(|texel| {
                 let centre = layout.center_direction(texel);
-                if at.material.in_support(&at.frame, at.wo, centre) {
+                if at.bsdf.in_support(at.wo, centre) {
                     map.texel_affinity(0, texel).max(floor)
                 } else {
                     floor
@@ -164,7 +164,7 @@ impl Guide {
         }
         let built = self.distribution.set_weights(|texel| {
             let centre = layout.center_direction(texel);
-            if !at.material.in_support(&at.frame, at.wo, centre) {
+            if !at.bsdf.in_support(at.wo, centre) {
                 return 0.0;
             }
             let density = strategy.pdf(at, &mut Toward::new(centre)) as f32;

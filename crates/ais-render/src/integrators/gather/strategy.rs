@@ -1,13 +1,12 @@
 //! Proposal samplers for the gather: uniform, BSDF, light, and their MIS mixture. Each gives
 //! a direction and the density of the whole strategy at that direction.
 
-use crate::bsdf::{Material, ShadingFrame};
+use crate::bsdf::{HitBsdf, ShadingFrame, SurfacePoint};
 use crate::geometry::Hit;
 use crate::lights::{Lights, Receiver, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
-use std::borrow::Cow;
 use std::f64::consts::PI;
 
 /// Which distribution proposes the gather's candidate directions.
@@ -55,29 +54,31 @@ pub struct GatherPoint<'a> {
     /// The shading point, where light is received (with the environment guide of guided
     /// gathers, and what the gather's light queries share).
     pub receiver: Receiver<'a>,
-    /// Its frame.
+    /// The frame that stands for the surface (for what keys on the normal, and for
+    /// offsetting rays); the BSDF holds its materials' own frames.
     pub frame: ShadingFrame,
     /// Direction toward the viewer.
     pub wo: Vec3,
-    /// Its material (with its texture's albedo at the hit, if it has one).
-    pub material: Cow<'a, Material>,
+    /// The BSDF at the hit (with its textures' values there).
+    pub bsdf: HitBsdf<'a>,
     /// The scene's emitters.
     pub lights: &'a Lights,
 }
 
 /// The gather point where `hit` is seen from direction `wo` (pointing away from it).
 pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a> {
-    let material = match &world.albedo_textures[hit.shape as usize] {
-        Some(texture) => {
-            Cow::Owned(world.materials[hit.shape as usize].with_albedo(texture.eval(hit.uv)))
-        }
-        None => Cow::Borrowed(&world.materials[hit.shape as usize]),
+    let point = SurfacePoint {
+        uv: hit.uv,
+        shading_normal: hit.shading_normal,
+        geometric_normal: hit.geometric_normal,
+        wo,
     };
+    let (bsdf, frame) = world.surfaces[hit.shape as usize].at(&point);
     GatherPoint {
         receiver: Receiver::new(hit.point),
-        frame: ShadingFrame::new(&material, hit.shading_normal, hit.geometric_normal, wo),
+        frame,
         wo,
-        material,
+        bsdf,
         lights: &world.lights,
     }
 }
@@ -87,10 +88,7 @@ impl GatherPoint<'_> {
     /// direction always can, any other only inside the BSDF's continuous support.
     #[inline]
     pub fn carries(&self, toward: &Toward) -> bool {
-        toward.specular.is_some()
-            || self
-                .material
-                .in_support(&self.frame, self.wo, toward.direction)
+        toward.specular.is_some() || self.bsdf.in_support(self.wo, toward.direction)
     }
 
     /// What the surface multiplies the radiance arriving along `toward` by: a specular
@@ -99,14 +97,14 @@ impl GatherPoint<'_> {
     pub fn scattering(&self, toward: &Toward) -> Vec3 {
         match toward.specular {
             Some(mass) => mass.weight,
-            None => self.material.eval(&self.frame, self.wo, toward.direction),
+            None => self.bsdf.eval(self.wo, toward.direction),
         }
     }
 
     /// A direction drawn from the BSDF (`None`: nothing scatters toward the viewer).
     #[inline]
     fn sample_bsdf(&self, u: [f32; 2]) -> Option<Toward> {
-        let sample = self.material.sample_lobe(&self.frame, self.wo, u)?;
+        let sample = self.bsdf.sample_lobe(self.wo, u)?;
         Some(match sample.specular {
             Some(mass) => Toward::specular(sample.direction, mass),
             None => Toward::new(sample.direction),
@@ -130,7 +128,7 @@ impl Strategy {
     pub fn sample(self, at: &GatherPoint, u: [f32; 2]) -> Option<(Vec3, f64)> {
         match self.effective(at) {
             Strategy::Uniform => Some((uniform_sphere(u), 1.0 / (4.0 * PI))),
-            Strategy::Bsdf => Some(at.material.sample(&at.frame, at.wo, u)),
+            Strategy::Bsdf => Some(at.bsdf.sample(at.wo, u)),
             Strategy::Light | Strategy::Mis => {
                 let direction = self.sample_direction(at, u)?.direction;
                 let pdf = self.density(at, direction);
@@ -144,11 +142,10 @@ impl Strategy {
         let light = || at.lights.pdf_over_directions(&at.receiver, direction);
         match self.effective(at) {
             Strategy::Uniform => 1.0 / (4.0 * PI),
-            Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, direction),
+            Strategy::Bsdf => at.bsdf.pdf(at.wo, direction),
             Strategy::Light => light(),
             Strategy::Mis => {
-                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, direction)
-                    + (1.0 - MIS_BSDF_WEIGHT) * light()
+                MIS_BSDF_WEIGHT * at.bsdf.pdf(at.wo, direction) + (1.0 - MIS_BSDF_WEIGHT) * light()
             }
         }
     }
@@ -191,13 +188,13 @@ impl Strategy {
         }
         match self.effective(at) {
             Strategy::Uniform => 1.0 / (4.0 * PI),
-            Strategy::Bsdf => at.material.pdf(&at.frame, at.wo, toward.direction),
+            Strategy::Bsdf => at.bsdf.pdf(at.wo, toward.direction),
             Strategy::Light => light(toward),
             // Toward a point, spot or directional light: a point mass of light sampling,
             // which the BSDF's density does not add to.
             Strategy::Mis if toward.is_delta() => (1.0 - MIS_BSDF_WEIGHT) * light(toward),
             Strategy::Mis => {
-                MIS_BSDF_WEIGHT * at.material.pdf(&at.frame, at.wo, toward.direction)
+                MIS_BSDF_WEIGHT * at.bsdf.pdf(at.wo, toward.direction)
                     + (1.0 - MIS_BSDF_WEIGHT) * light(toward)
             }
         }

@@ -1,0 +1,197 @@
+//! What a shape's `<bsdf>` gives at each point of the shape: a material whose albedo may
+//! come from a texture, Mitsuba's `mask` (an opacity over a material) and `blendbsdf` (two
+//! materials mixed by a weight), each of which may vary over the surface, and `null`.
+//! [`Surface::at`] resolves it at a hit into the [`HitBsdf`] the gather evaluates.
+
+use super::hit::{HitBsdf, Mixture, MixturePart};
+use super::{Material, ShadingFrame};
+use crate::texture::Texture;
+use glam::{Vec2, Vec3};
+use std::borrow::Cow;
+use std::sync::Arc;
+
+/// A shape's scattering over its surface.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Surface {
+    /// One material; its albedo is the texture's value at the hit when it has one.
+    Material {
+        /// The material (with the constant albedo a texture replaces).
+        material: Material,
+        /// The texture that gives the albedo, if one does.
+        albedo: Option<Arc<Texture>>,
+    },
+    /// Mitsuba's `mask`: the material where the surface is opaque; light passes straight
+    /// through elsewhere.
+    Mask {
+        /// Opacity in [0, 1].
+        opacity: Fraction,
+        /// The material of the opaque part.
+        inner: Box<Surface>,
+    },
+    /// Mitsuba's `blendbsdf`: `(1 - weight) first + weight second`.
+    Blend {
+        /// The second's share, in [0, 1].
+        weight: Fraction,
+        /// The first material.
+        first: Box<Surface>,
+        /// The second material.
+        second: Box<Surface>,
+    },
+    /// Mitsuba's `null`: light passes straight through, nothing scatters.
+    Null,
+}
+
+/// A share in [0, 1] that may vary over the surface.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Fraction {
+    /// The same everywhere.
+    Constant(f32),
+    /// A texture read as one channel at the hit ([`Texture::eval_scalar`]), clamped to
+    /// [0, 1].
+    Texture(Arc<Texture>),
+}
+
+impl Fraction {
+    /// Whether a texture gives it.
+    fn is_textured(&self) -> bool {
+        matches!(self, Fraction::Texture(_))
+    }
+
+    /// The share at texture coordinates `uv`.
+    pub fn at(&self, uv: Vec2) -> f32 {
+        let value = match self {
+            Fraction::Constant(value) => *value,
+            Fraction::Texture(texture) => texture.eval_scalar(uv),
+        };
+        if value.is_nan() {
+            0.0
+        } else {
+            value.clamp(0.0, 1.0)
+        }
+    }
+}
+
+/// The geometry a surface is resolved at.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Interpolated shading normal.
+    pub shading_normal: Vec3,
+    /// Geometric normal.
+    pub geometric_normal: Vec3,
+    /// Direction toward the viewer.
+    pub wo: Vec3,
+}
+
+impl From<Material> for Surface {
+    fn from(material: Material) -> Self {
+        Surface::Material {
+            material,
+            albedo: None,
+        }
+    }
+}
+
+impl Surface {
+    /// This surface seen from both sides (Mitsuba's `twosided` around it).
+    pub fn two_sided(mut self) -> Surface {
+        match &mut self {
+            Surface::Material { material, .. } => material.two_sided = true,
+            Surface::Mask { inner, .. } => **inner = inner.as_ref().clone().two_sided(),
+            Surface::Blend { first, second, .. } => {
+                **first = first.as_ref().clone().two_sided();
+                **second = second.as_ref().clone().two_sided();
+            }
+            Surface::Null => {}
+        }
+        self
+    }
+
+    /// Whether anything varies over the surface by texture coordinates.
+    pub fn is_textured(&self) -> bool {
+        match self {
+            Surface::Material { albedo, .. } => albedo.is_some(),
+            Surface::Mask { opacity, inner } => opacity.is_textured() || inner.is_textured(),
+            Surface::Blend {
+                weight,
+                first,
+                second,
+            } => weight.is_textured() || first.is_textured() || second.is_textured(),
+            Surface::Null => false,
+        }
+    }
+
+    /// Whether the frame at a hit faces the viewer from either side: true when any of its
+    /// materials is two-sided.
+    fn any_two_sided(&self) -> bool {
+        match self {
+            Surface::Material { material, .. } => material.two_sided,
+            Surface::Mask { inner, .. } => inner.any_two_sided(),
+            Surface::Blend { first, second, .. } => first.any_two_sided() || second.any_two_sided(),
+            Surface::Null => false,
+        }
+    }
+
+    /// The BSDF at `point`, and the frame that stands for the surface there (for what
+    /// keys on the normal, and for offsetting rays).
+    pub fn at(&self, point: &SurfacePoint) -> (HitBsdf<'_>, ShadingFrame) {
+        if let Surface::Material { material, albedo } = self {
+            let material = match albedo {
+                Some(texture) => Cow::Owned(material.with_albedo(texture.eval(point.uv))),
+                None => Cow::Borrowed(material),
+            };
+            let frame = point.frame(material.two_sided);
+            return (HitBsdf::Single { material, frame }, frame);
+        }
+        let mut mixture = Mixture::default();
+        self.add_parts(point, 1.0, &mut mixture);
+        let frame = point.frame(self.any_two_sided());
+        (HitBsdf::Mixture(Box::new(mixture)), frame)
+    }
+
+    /// Adds this surface's materials, and what passes through, with `share` of the total.
+    fn add_parts(&self, point: &SurfacePoint, share: f32, mixture: &mut Mixture) {
+        match self {
+            Surface::Material { material, albedo } => {
+                let material = match albedo {
+                    Some(texture) => material.with_albedo(texture.eval(point.uv)),
+                    None => material.clone(),
+                };
+                let frame = point.frame(material.two_sided);
+                mixture.parts.push(MixturePart {
+                    weight: share,
+                    material,
+                    frame,
+                });
+            }
+            Surface::Mask { opacity, inner } => {
+                let opacity = opacity.at(point.uv);
+                inner.add_parts(point, share * opacity, mixture);
+                mixture.pass_through += share * (1.0 - opacity);
+            }
+            Surface::Blend {
+                weight,
+                first,
+                second,
+            } => {
+                let weight = weight.at(point.uv);
+                first.add_parts(point, share * (1.0 - weight), mixture);
+                second.add_parts(point, share * weight, mixture);
+            }
+            Surface::Null => mixture.pass_through += share,
+        }
+    }
+}
+
+impl SurfacePoint {
+    /// The shading frame here for a material that is (or not) two-sided.
+    fn frame(&self, two_sided: bool) -> ShadingFrame {
+        ShadingFrame::oriented(
+            self.shading_normal,
+            self.geometric_normal,
+            self.wo,
+            two_sided,
+        )
+    }
+}
