@@ -11,6 +11,7 @@ a flat (uncompressed) Radiance RGBE image. It also writes, into the same folder:
   a slab 4 x 0.8 x 4 m, a canopy that occludes partly at every scale;
 - ball.obj: a smooth sphere of radius 1 with 7,920 triangles, an emitting mesh;
 - tiles.png: a 16 x 8 sRGB image of coloured tiles with a gradient, for bitmap textures;
+- bumps.png: a 64 x 64 tangent-space normal map of domes, for normalmap;
 - quad.obj: a unit square with texture coordinates (OBJ's v up), for textured meshes;
 - shapes.serialized: Mitsuba's serialized format (version 4) with two shapes: a square with
   texture coordinates in single precision, and a pyramid with vertex normals in double
@@ -153,6 +154,19 @@ def tile(x, y):
     return (int(r * shade), int(g * shade), int(b * shade))
 
 
+def bump_normal(x, y):
+    """A tangent-space normal map of 4 x 4 domes over 64 x 64 texels, encoded (n + 1) / 2
+    (read it raw): the normals of the height field 0.04 sin(2 pi 4 u) sin(2 pi 4 v) per texel."""
+    u, v = (x + 0.5) / 64, (y + 0.5) / 64
+    k = 2 * math.pi * 4
+    slope = 0.04 * k
+    dx = slope * math.cos(k * u) * math.sin(k * v)
+    dy = slope * math.sin(k * u) * math.cos(k * v)
+    n = (-dx, -dy, 1.0)
+    length = math.sqrt(sum(c * c for c in n))
+    return tuple(int(round((c / length * 0.5 + 0.5) * 255)) for c in n)
+
+
 def write_quad(path):
     """The square [-1, 1]^2 at z = 0 with texture coordinates running over [0, 2] x [0, 1]."""
     write_obj(path, ["v -1 -1 0", "v 1 -1 0", "v 1 1 0", "v -1 1 0",
@@ -204,6 +218,7 @@ def main():
     os.makedirs(folder, exist_ok=True)
     write_serialized(os.path.join(folder, "shapes.serialized"))
     write_png(os.path.join(folder, "tiles.png"), 16, 8, tile)
+    write_png(os.path.join(folder, "bumps.png"), 64, 64, bump_normal)
     write_quad(os.path.join(folder, "quad.obj"))
     write_blob(os.path.join(folder, "blob.obj"))
     write_leaves(os.path.join(folder, "leaves.obj"))

@@ -349,6 +349,7 @@ fn surface_point() -> SurfacePoint {
         shading_normal: normal,
         geometric_normal: normal,
         wo: Vec3::new(-0.3, 0.2, 1.0).normalize(),
+        dp_du: Vec3::ZERO,
     }
 }
 
@@ -519,6 +520,7 @@ fn mixture_sampling_fits_and_passes_light_through() {
             shading_normal: frame.normal,
             geometric_normal: frame.geometric,
             wo: *wo,
+            dp_du: Vec3::ZERO,
         };
         let surface = masked_blend();
         let (bsdf, _) = surface.at(&point);

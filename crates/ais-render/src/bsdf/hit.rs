@@ -9,6 +9,7 @@
 //! point mass along `-wo` (what Mitsuba's direct integrator sees through it: the emitters
 //! behind, not the surfaces).
 
+use super::normal_map::Tilt;
 use super::{BsdfSample, Material, ShadingFrame, SpecularMass};
 use glam::Vec3;
 use std::borrow::Cow;
@@ -46,6 +47,32 @@ pub struct MixturePart {
     pub material: Material,
     /// Its shading frame.
     pub frame: ShadingFrame,
+    /// When a normal map tilted the frame: what the unperturbed one still decides.
+    pub tilt: Option<Tilt>,
+}
+
+impl MixturePart {
+    /// Whether `wi` can carry light to `wo` through the part's continuous part.
+    #[inline]
+    fn in_support(&self, wo: Vec3, wi: Vec3) -> bool {
+        self.weight > 0.0
+            && self.material.in_support(&self.frame, wo, wi)
+            && self
+                .tilt
+                .is_none_or(|tilt| tilt.factor(self.frame.normal, wi) > 0.0)
+    }
+
+    /// The part's BSDF times |cos θi|, weighted.
+    #[inline]
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
+        let tilt = self
+            .tilt
+            .map_or(1.0, |tilt| tilt.factor(self.frame.normal, wi));
+        if tilt == 0.0 {
+            return Vec3::ZERO;
+        }
+        self.weight * tilt * self.material.eval(&self.frame, wo, wi)
+    }
 }
 
 impl HitBsdf<'_> {
@@ -54,10 +81,7 @@ impl HitBsdf<'_> {
     pub fn in_support(&self, wo: Vec3, wi: Vec3) -> bool {
         match self {
             HitBsdf::Single { material, frame } => material.in_support(frame, wo, wi),
-            HitBsdf::Mixture(mixture) => mixture
-                .parts
-                .iter()
-                .any(|p| p.weight > 0.0 && p.material.in_support(&p.frame, wo, wi)),
+            HitBsdf::Mixture(mixture) => mixture.parts.iter().any(|p| p.in_support(wo, wi)),
         }
     }
 
@@ -66,11 +90,7 @@ impl HitBsdf<'_> {
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {
         match self {
             HitBsdf::Single { material, frame } => material.eval(frame, wo, wi),
-            HitBsdf::Mixture(mixture) => mixture
-                .parts
-                .iter()
-                .map(|p| p.weight * p.material.eval(&p.frame, wo, wi))
-                .sum(),
+            HitBsdf::Mixture(mixture) => mixture.parts.iter().map(|p| p.eval(wo, wi)).sum(),
         }
     }
 
@@ -126,10 +146,13 @@ impl Mixture {
             if picked && part.weight > 0.0 {
                 let reused = ((u[0] - start) / part.weight).clamp(0.0, 1.0 - 1e-7);
                 let sample = part.material.sample_lobe(&part.frame, wo, [reused, u[1]])?;
+                let tilt = part
+                    .tilt
+                    .map_or(1.0, |tilt| tilt.factor(part.frame.normal, sample.direction));
                 return Some(BsdfSample {
                     direction: sample.direction,
                     specular: sample.specular.map(|mass| SpecularMass {
-                        weight: mass.weight * part.weight,
+                        weight: mass.weight * (part.weight * tilt),
                         probability: mass.probability * part.weight,
                     }),
                 });

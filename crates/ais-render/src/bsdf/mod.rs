@@ -6,6 +6,7 @@ mod albedo;
 mod conductors;
 mod hit;
 mod microfacet;
+mod normal_map;
 mod reader;
 mod rough_dielectric;
 mod rough_plastic;
@@ -17,6 +18,7 @@ pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
 pub use hit::{HitBsdf, Mixture, MixturePart};
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
+pub use normal_map::NormalMapOptions;
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
@@ -137,6 +139,17 @@ impl ShadingFrame {
         } else {
             (shading_normal, geometric_normal)
         };
+        let (tangent, bitangent) = basis(normal);
+        ShadingFrame {
+            normal,
+            geometric,
+            tangent,
+            bitangent,
+        }
+    }
+
+    /// A frame around `normal` (unit), with `geometric` on its side.
+    pub fn with_normal(normal: Vec3, geometric: Vec3) -> Self {
         let (tangent, bitangent) = basis(normal);
         ShadingFrame {
             normal,

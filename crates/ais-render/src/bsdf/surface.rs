@@ -4,7 +4,8 @@
 //! [`Surface::at`] resolves it at a hit into the [`HitBsdf`] the gather evaluates.
 
 use super::hit::{HitBsdf, Mixture, MixturePart};
-use super::{Material, ShadingFrame};
+use super::normal_map::tilted_frame;
+use super::{Material, NormalMapOptions, ShadingFrame};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::borrow::Cow;
@@ -36,6 +37,16 @@ pub enum Surface {
         first: Box<Surface>,
         /// The second material.
         second: Box<Surface>,
+    },
+    /// Mitsuba's `normalmap`: the inner surface's shading normal from a tangent-space
+    /// texture.
+    NormalMap {
+        /// The normals, encoded as (n + 1) / 2.
+        normals: Arc<Texture>,
+        /// How they are applied.
+        options: NormalMapOptions,
+        /// The surface whose frame they tilt.
+        inner: Box<Surface>,
     },
     /// Mitsuba's `null`: light passes straight through, nothing scatters.
     Null,
@@ -82,6 +93,8 @@ pub struct SurfacePoint {
     pub geometric_normal: Vec3,
     /// Direction toward the viewer.
     pub wo: Vec3,
+    /// ∂p/∂u (zero without texture coordinates): where a normal map's tangent points.
+    pub dp_du: Vec3,
 }
 
 impl From<Material> for Surface {
@@ -98,7 +111,9 @@ impl Surface {
     pub fn two_sided(mut self) -> Surface {
         match &mut self {
             Surface::Material { material, .. } => material.two_sided = true,
-            Surface::Mask { inner, .. } => **inner = inner.as_ref().clone().two_sided(),
+            Surface::Mask { inner, .. } | Surface::NormalMap { inner, .. } => {
+                **inner = inner.as_ref().clone().two_sided()
+            }
             Surface::Blend { first, second, .. } => {
                 **first = first.as_ref().clone().two_sided();
                 **second = second.as_ref().clone().two_sided();
@@ -113,6 +128,7 @@ impl Surface {
         match self {
             Surface::Material { albedo, .. } => albedo.is_some(),
             Surface::Mask { opacity, inner } => opacity.is_textured() || inner.is_textured(),
+            Surface::NormalMap { .. } => true,
             Surface::Blend {
                 weight,
                 first,
@@ -127,7 +143,7 @@ impl Surface {
     fn any_two_sided(&self) -> bool {
         match self {
             Surface::Material { material, .. } => material.two_sided,
-            Surface::Mask { inner, .. } => inner.any_two_sided(),
+            Surface::Mask { inner, .. } | Surface::NormalMap { inner, .. } => inner.any_two_sided(),
             Surface::Blend { first, second, .. } => first.any_two_sided() || second.any_two_sided(),
             Surface::Null => false,
         }
@@ -163,6 +179,7 @@ impl Surface {
                     weight: share,
                     material,
                     frame,
+                    tilt: None,
                 });
             }
             Surface::Mask { opacity, inner } => {
@@ -178,6 +195,27 @@ impl Surface {
                 let weight = weight.at(point.uv);
                 first.add_parts(point, share * (1.0 - weight), mixture);
                 second.add_parts(point, share * weight, mixture);
+            }
+            Surface::NormalMap {
+                normals,
+                options,
+                inner,
+            } => {
+                let first = mixture.parts.len();
+                inner.add_parts(point, share, mixture);
+                let texel = normals.eval(point.uv);
+                for part in &mut mixture.parts[first..] {
+                    let (frame, tilt) = tilted_frame(
+                        &part.frame,
+                        point.shading_normal,
+                        point.dp_du,
+                        texel,
+                        point.wo,
+                        *options,
+                    );
+                    part.frame = frame;
+                    part.tilt = Some(tilt);
+                }
             }
             Surface::Null => mixture.pass_through += share,
         }

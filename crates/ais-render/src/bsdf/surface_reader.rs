@@ -4,7 +4,7 @@
 
 use super::albedo::{albedo_texture, parameter_texture, TextureScene};
 use super::surface::{Fraction, Surface};
-use super::Material;
+use super::{Material, NormalMapOptions};
 use crate::error::InputError;
 use crate::scene::{ColourRole, Plugin};
 use crate::texture::luminance;
@@ -15,7 +15,10 @@ const DEEPEST_SURFACE: usize = 16;
 
 /// The types read here rather than as one material.
 fn is_composite(kind: &str) -> bool {
-    matches!(kind, "mask" | "blendbsdf" | "null" | "twosided")
+    matches!(
+        kind,
+        "mask" | "blendbsdf" | "null" | "twosided" | "normalmap"
+    )
 }
 
 /// Reads the `<bsdf>` `plugin` of `scene` (a top-level one, a nested one, or one that a
@@ -48,6 +51,7 @@ impl<'a> SurfaceReader<'a, '_> {
         let known: &[&str] = match plugin.kind.as_str() {
             "mask" => &["opacity"],
             "blendbsdf" => &["weight"],
+            "normalmap" => &["flip_invalid_normals", "use_shadowing_function"],
             _ => &[],
         };
         crate::scene::warn_unknown(self.scene.file, plugin, known, self.warnings);
@@ -60,6 +64,14 @@ impl<'a> SurfaceReader<'a, '_> {
             ("twosided", _) => self.material(plugin),
             ("mask", [inner]) => Ok(Surface::Mask {
                 opacity: self.fraction(plugin, "opacity", Some(0.5))?,
+                inner: Box::new(self.read(inner, depth + 1)?),
+            }),
+            ("normalmap", [inner]) => Ok(Surface::NormalMap {
+                normals: self.required_texture(plugin, "normalmap")?,
+                options: NormalMapOptions {
+                    flip_invalid_normals: self.flag(plugin, "flip_invalid_normals")?,
+                    use_shadowing_function: self.flag(plugin, "use_shadowing_function")?,
+                },
                 inner: Box::new(self.read(inner, depth + 1)?),
             }),
             ("blendbsdf", [first, second]) => Ok(Surface::Blend {
@@ -101,7 +113,7 @@ impl<'a> SurfaceReader<'a, '_> {
             .map(|c| (c.line, c))
             .collect();
         for (name, id, line) in &plugin.references {
-            let is_parameter = matches!(name.as_deref(), Some("opacity" | "weight"));
+            let is_parameter = matches!(name.as_deref(), Some("opacity" | "weight" | "normalmap"));
             let bsdf = self
                 .scene
                 .bsdfs
@@ -118,6 +130,29 @@ impl<'a> SurfaceReader<'a, '_> {
         }
         found.sort_by_key(|(line, _)| *line);
         Ok(found.into_iter().map(|(_, bsdf)| bsdf).collect())
+    }
+
+    /// The texture `name` of `plugin`, which must have one.
+    fn required_texture(
+        &mut self,
+        plugin: &Plugin,
+        name: &str,
+    ) -> Result<Arc<crate::texture::Texture>, InputError> {
+        match parameter_texture(plugin, name, self.scene, self.warnings)? {
+            Some(texture) => Ok(Arc::new(texture)),
+            None => Err(InputError::at(
+                self.scene.file,
+                plugin.line,
+                format!("a \"{}\" needs a <texture name=\"{name}\">", plugin.kind),
+            )),
+        }
+    }
+
+    /// A boolean property that defaults to true.
+    fn flag(&self, plugin: &Plugin, name: &str) -> Result<bool, InputError> {
+        plugin
+            .boolean(name, true)
+            .map_err(|(line, message)| InputError::at(self.scene.file, line, message))
     }
 
     /// A share in [0, 1]: a texture, a float, or a colour's luminance (`None`: required).

@@ -50,6 +50,9 @@ pub struct Hit {
     pub shape: u32,
     /// Texture coordinates (Mitsuba's conventions; zero on a mesh without them).
     pub uv: Vec2,
+    /// How the point moves with u (∂p/∂u, unnormalised): where a normal map's tangent space
+    /// points. Zero where there are no texture coordinates, or they are degenerate.
+    pub dp_du: Vec3,
 }
 
 /// Per-mesh data needed to shade a triangle hit.
@@ -310,19 +313,19 @@ impl Geometry {
         } else {
             1.0
         };
-        let (geometric_normal, shading_normal, uv) = match &self.packed[index] {
+        let (geometric_normal, shading_normal, uv, dp_du) = match &self.packed[index] {
             Packed::Sphere(s) => {
                 let outward = (point - s.center).normalize();
-                (outward * flip, outward * flip, sphere_texcoords(outward))
+                // Mitsuba's sphere: u is the azimuth about z.
+                let dp_du = Vec3::new(-outward.y, outward.x, 0.0);
+                let uv = sphere_texcoords(outward);
+                (outward * flip, outward * flip, uv, dp_du)
             }
-            triangle => {
-                let n = triangle.triangle_normal().unwrap_or(Vec3::Y).normalize() * flip;
+            Packed::Triangle([_, e1, e2]) => {
+                let n = e1.cross(*e2).normalize() * flip;
                 let shading = self.interpolated_normal(source, barycentrics).unwrap_or(n);
-                (
-                    n,
-                    shading,
-                    self.interpolated_texcoords(source, barycentrics),
-                )
+                let uv = self.interpolated_texcoords(source, barycentrics);
+                (n, shading, uv, self.uv_tangent(source, *e1, *e2))
             }
         };
         Hit {
@@ -332,6 +335,7 @@ impl Geometry {
             shading_normal,
             shape: source.shape,
             uv,
+            dp_du,
         }
     }
 
@@ -346,6 +350,22 @@ impl Geometry {
         texcoords[a as usize] * (1.0 - barycentrics.x - barycentrics.y)
             + texcoords[b as usize] * barycentrics.x
             + texcoords[c as usize] * barycentrics.y
+    }
+
+    /// ∂p/∂u over a triangle with edges `e1`, `e2` from its texture coordinates (zero when
+    /// its mesh has none, or they do not span the plane).
+    fn uv_tangent(&self, source: PrimitiveSource, e1: Vec3, e2: Vec3) -> Vec3 {
+        let mesh = &self.meshes[source.mesh as usize];
+        let Some(texcoords) = mesh.texcoords.as_ref() else {
+            return Vec3::ZERO;
+        };
+        let [a, b, c] = mesh.triangles[source.index as usize].map(|i| texcoords[i as usize]);
+        let (duv1, duv2) = (b - a, c - a);
+        let determinant = duv1.x * duv2.y - duv1.y * duv2.x;
+        if determinant.abs() <= f32::MIN_POSITIVE || !determinant.is_finite() {
+            return Vec3::ZERO;
+        }
+        (e1 * duv2.y - e2 * duv1.y) / determinant
     }
 
     /// The vertex normals of a triangle's mesh interpolated at `barycentrics` (None: the mesh

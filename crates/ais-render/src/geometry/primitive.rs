@@ -63,14 +63,6 @@ impl Packed {
             Packed::Sphere(s) => s.intersect(ray, t_max).map(|t| (t, Vec2::ZERO)),
         }
     }
-
-    /// The unnormalised geometric normal of a triangle (e1 × e2).
-    pub(crate) fn triangle_normal(&self) -> Option<Vec3> {
-        match self {
-            Packed::Triangle([_, e1, e2]) => Some(e1.cross(*e2)),
-            Packed::Sphere(_) => None,
-        }
-    }
 }
 
 /// Möller-Trumbore with the edges given: the distance and barycentrics (b1, b2) of the hit,

@@ -66,6 +66,7 @@ pub fn shipped_scenes() -> Result<PathBuf, String> {
         "leaves.obj",
         "ball.obj",
         "tiles.png",
+        "bumps.png",
         "quad.obj",
         "shapes.serialized",
     ];

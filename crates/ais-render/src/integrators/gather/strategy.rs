@@ -72,6 +72,7 @@ pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a
         shading_normal: hit.shading_normal,
         geometric_normal: hit.geometric_normal,
         wo,
+        dp_du: hit.dp_du,
     };
     let (bsdf, frame) = world.surfaces[hit.shape as usize].at(&point);
     GatherPoint {
