@@ -126,6 +126,42 @@ impl Texture {
         };
         luminance(colour)
     }
+
+    /// The gradient of [`Texture::eval_scalar`] over (u, v) ([`Bitmap::scalar_gradient`]);
+    /// zero for a checkerboard, which is flat almost everywhere.
+    pub fn scalar_gradient(&self, uv: Vec2) -> Vec2 {
+        match self {
+            Texture::Checkerboard { .. } => Vec2::ZERO,
+            Texture::Bitmap(bitmap) => bitmap.scalar_gradient(uv),
+        }
+    }
+}
+
+impl Bitmap {
+    /// The gradient of the one-channel lookup with respect to (u, v), as Mitsuba's
+    /// `eval_1_grad` gives it: zero for nearest filtering; for bilinear, the partials over
+    /// pixel coordinates taken through the transpose of `to_uv`'s linear part, then scaled
+    /// by the resolution.
+    pub fn scalar_gradient(&self, uv: Vec2) -> Vec2 {
+        if !self.bilinear {
+            return Vec2::ZERO;
+        }
+        let size = Vec2::new(self.image.width as f32, self.image.height as f32);
+        let position = self.to_uv.apply(uv) * size - 0.5;
+        if !position.is_finite() {
+            return Vec2::ZERO;
+        }
+        let corner = position.floor();
+        let w1 = position - corner;
+        let w0 = Vec2::ONE - w1;
+        let (x, y) = (corner.x as i64, corner.y as i64);
+        let f = |dx: i64, dy: i64| luminance(self.texel(x + dx, y + dy));
+        let (f00, f10, f01, f11) = (f(0, 0), f(1, 0), f(0, 1), f(1, 1));
+        let dx = w0.y * (f10 - f00) + w1.y * (f11 - f01);
+        let dy = w0.x * (f01 - f00) + w1.x * (f11 - f10);
+        let [a, b, _, d, e, _] = self.to_uv.0;
+        Vec2::new(a * dx + d * dy, b * dx + e * dy) * size
+    }
 }
 
 /// Rec. 709 luminance of linear RGB (Mitsuba's one-channel reading of a colour).

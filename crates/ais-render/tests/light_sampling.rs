@@ -350,6 +350,7 @@ fn surface_point() -> SurfacePoint {
         geometric_normal: normal,
         wo: Vec3::new(-0.3, 0.2, 1.0).normalize(),
         dp_du: Vec3::ZERO,
+        dp_dv: Vec3::ZERO,
     }
 }
 
@@ -521,6 +522,7 @@ fn mixture_sampling_fits_and_passes_light_through() {
             geometric_normal: frame.geometric,
             wo: *wo,
             dp_du: Vec3::ZERO,
+            dp_dv: Vec3::ZERO,
         };
         let surface = masked_blend();
         let (bsdf, _) = surface.at(&point);

@@ -9,7 +9,7 @@
 //! point mass along `-wo` (what Mitsuba's direct integrator sees through it: the emitters
 //! behind, not the surfaces).
 
-use super::normal_map::Tilt;
+use super::tilted_normals::Tilt;
 use super::{BsdfSample, Material, ShadingFrame, SpecularMass};
 use glam::Vec3;
 use std::borrow::Cow;

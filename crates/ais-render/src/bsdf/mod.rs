@@ -6,24 +6,24 @@ mod albedo;
 mod conductors;
 mod hit;
 mod microfacet;
-mod normal_map;
 mod reader;
 mod rough_dielectric;
 mod rough_plastic;
 mod specular;
 mod surface;
 mod surface_reader;
+mod tilted_normals;
 
 pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
 pub use hit::{HitBsdf, Mixture, MixturePart};
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
-pub use normal_map::NormalMapOptions;
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
-pub use surface::{Fraction, Surface, SurfacePoint};
+pub use surface::{Fraction, Surface, SurfacePoint, TiltedNormals};
 pub use surface_reader::read_surface;
+pub use tilted_normals::NormalMapOptions;
 
 use crate::geometry::basis;
 use crate::scene::Plugin;

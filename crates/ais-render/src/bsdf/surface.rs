@@ -4,7 +4,7 @@
 //! [`Surface::at`] resolves it at a hit into the [`HitBsdf`] the gather evaluates.
 
 use super::hit::{HitBsdf, Mixture, MixturePart};
-use super::normal_map::tilted_frame;
+use super::tilted_normals::{bump_map_normal, normal_map_normal, tilted_frame};
 use super::{Material, NormalMapOptions, ShadingFrame};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
@@ -38,18 +38,44 @@ pub enum Surface {
         /// The second material.
         second: Box<Surface>,
     },
-    /// Mitsuba's `normalmap`: the inner surface's shading normal from a tangent-space
+    /// Mitsuba's `normalmap` and `bumpmap`: the inner surface's shading normal tilted by a
     /// texture.
-    NormalMap {
-        /// The normals, encoded as (n + 1) / 2.
-        normals: Arc<Texture>,
-        /// How they are applied.
+    Tilted {
+        /// The texture and how it gives the normal.
+        normals: TiltedNormals,
+        /// How the tilted normal is applied.
         options: NormalMapOptions,
-        /// The surface whose frame they tilt.
+        /// The surface whose frame it tilts.
         inner: Box<Surface>,
     },
     /// Mitsuba's `null`: light passes straight through, nothing scatters.
     Null,
+}
+
+/// Where tilted shading normals come from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum TiltedNormals {
+    /// A tangent-space normal map, encoded as (n + 1) / 2.
+    NormalMap(Arc<Texture>),
+    /// A height map (a bitmap read as one channel), times `scale`.
+    BumpMap {
+        /// The heights.
+        height: Arc<Texture>,
+        /// Their scale.
+        scale: f32,
+    },
+}
+
+impl TiltedNormals {
+    /// The tilted normal at `point`, in the frame (s, t, n_s).
+    fn local_normal(&self, point: &SurfacePoint) -> Vec3 {
+        match self {
+            TiltedNormals::NormalMap(texture) => normal_map_normal(texture.eval(point.uv)),
+            TiltedNormals::BumpMap { height, scale } => {
+                bump_map_normal(point, *scale * height.scalar_gradient(point.uv))
+            }
+        }
+    }
 }
 
 /// A share in [0, 1] that may vary over the surface.
@@ -93,8 +119,10 @@ pub struct SurfacePoint {
     pub geometric_normal: Vec3,
     /// Direction toward the viewer.
     pub wo: Vec3,
-    /// ∂p/∂u (zero without texture coordinates): where a normal map's tangent points.
+    /// ∂p/∂u: where a normal map's tangent points.
     pub dp_du: Vec3,
+    /// ∂p/∂v.
+    pub dp_dv: Vec3,
 }
 
 impl From<Material> for Surface {
@@ -111,7 +139,7 @@ impl Surface {
     pub fn two_sided(mut self) -> Surface {
         match &mut self {
             Surface::Material { material, .. } => material.two_sided = true,
-            Surface::Mask { inner, .. } | Surface::NormalMap { inner, .. } => {
+            Surface::Mask { inner, .. } | Surface::Tilted { inner, .. } => {
                 **inner = inner.as_ref().clone().two_sided()
             }
             Surface::Blend { first, second, .. } => {
@@ -128,7 +156,7 @@ impl Surface {
         match self {
             Surface::Material { albedo, .. } => albedo.is_some(),
             Surface::Mask { opacity, inner } => opacity.is_textured() || inner.is_textured(),
-            Surface::NormalMap { .. } => true,
+            Surface::Tilted { .. } => true,
             Surface::Blend {
                 weight,
                 first,
@@ -143,7 +171,7 @@ impl Surface {
     fn any_two_sided(&self) -> bool {
         match self {
             Surface::Material { material, .. } => material.two_sided,
-            Surface::Mask { inner, .. } | Surface::NormalMap { inner, .. } => inner.any_two_sided(),
+            Surface::Mask { inner, .. } | Surface::Tilted { inner, .. } => inner.any_two_sided(),
             Surface::Blend { first, second, .. } => first.any_two_sided() || second.any_two_sided(),
             Surface::Null => false,
         }
@@ -196,23 +224,16 @@ impl Surface {
                 first.add_parts(point, share * (1.0 - weight), mixture);
                 second.add_parts(point, share * weight, mixture);
             }
-            Surface::NormalMap {
+            Surface::Tilted {
                 normals,
                 options,
                 inner,
             } => {
                 let first = mixture.parts.len();
                 inner.add_parts(point, share, mixture);
-                let texel = normals.eval(point.uv);
+                let local = normals.local_normal(point);
                 for part in &mut mixture.parts[first..] {
-                    let (frame, tilt) = tilted_frame(
-                        &part.frame,
-                        point.shading_normal,
-                        point.dp_du,
-                        texel,
-                        point.wo,
-                        *options,
-                    );
+                    let (frame, tilt) = tilted_frame(&part.frame, point, local, *options);
                     part.frame = frame;
                     part.tilt = Some(tilt);
                 }

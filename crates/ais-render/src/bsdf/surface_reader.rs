@@ -3,11 +3,11 @@
 //! ([`Material::from_plugin`]) with its albedo texture.
 
 use super::albedo::{albedo_texture, parameter_texture, TextureScene};
-use super::surface::{Fraction, Surface};
+use super::surface::{Fraction, Surface, TiltedNormals};
 use super::{Material, NormalMapOptions};
 use crate::error::InputError;
 use crate::scene::{ColourRole, Plugin};
-use crate::texture::luminance;
+use crate::texture::{luminance, read_texture, Texture};
 use std::sync::Arc;
 
 /// The deepest surfaces may nest (through children or references): deeper is a cycle.
@@ -17,7 +17,7 @@ const DEEPEST_SURFACE: usize = 16;
 fn is_composite(kind: &str) -> bool {
     matches!(
         kind,
-        "mask" | "blendbsdf" | "null" | "twosided" | "normalmap"
+        "mask" | "blendbsdf" | "null" | "twosided" | "normalmap" | "bumpmap"
     )
 }
 
@@ -52,6 +52,7 @@ impl<'a> SurfaceReader<'a, '_> {
             "mask" => &["opacity"],
             "blendbsdf" => &["weight"],
             "normalmap" => &["flip_invalid_normals", "use_shadowing_function"],
+            "bumpmap" => &["scale", "flip_invalid_normals", "use_shadowing_function"],
             _ => &[],
         };
         crate::scene::warn_unknown(self.scene.file, plugin, known, self.warnings);
@@ -66,8 +67,8 @@ impl<'a> SurfaceReader<'a, '_> {
                 opacity: self.fraction(plugin, "opacity", Some(0.5))?,
                 inner: Box::new(self.read(inner, depth + 1)?),
             }),
-            ("normalmap", [inner]) => Ok(Surface::NormalMap {
-                normals: self.required_texture(plugin, "normalmap")?,
+            ("normalmap" | "bumpmap", [inner]) => Ok(Surface::Tilted {
+                normals: self.tilted_normals(plugin)?,
                 options: NormalMapOptions {
                     flip_invalid_normals: self.flag(plugin, "flip_invalid_normals")?,
                     use_shadowing_function: self.flag(plugin, "use_shadowing_function")?,
@@ -119,9 +120,11 @@ impl<'a> SurfaceReader<'a, '_> {
                 .bsdfs
                 .iter()
                 .find(|b| b.id.as_deref() == Some(id.as_str()));
+            let texture =
+                (self.scene.textures.iter()).any(|t| t.id.as_deref() == Some(id.as_str()));
             match bsdf {
                 Some(bsdf) if !is_parameter => found.push((*line, bsdf)),
-                None if !is_parameter => {
+                None if !is_parameter && !texture => {
                     let message = format!("no <bsdf> with id \"{id}\"");
                     return Err(InputError::at(self.scene.file, *line, message));
                 }
@@ -132,12 +135,45 @@ impl<'a> SurfaceReader<'a, '_> {
         Ok(found.into_iter().map(|(_, bsdf)| bsdf).collect())
     }
 
+    /// A normal map's texture, or a bump map's (its one nested or referenced texture, a
+    /// bitmap) and scale.
+    fn tilted_normals(&mut self, plugin: &Plugin) -> Result<TiltedNormals, InputError> {
+        if plugin.kind == "normalmap" {
+            return Ok(TiltedNormals::NormalMap(
+                self.required_texture(plugin, "normalmap")?,
+            ));
+        }
+        let error = |message: String| InputError::at(self.scene.file, plugin.line, message);
+        let scene = self.scene;
+        let referenced = plugin.references.iter().find_map(|(_, id, _)| {
+            (scene.textures.iter()).find(|t| t.id.as_deref() == Some(id.as_str()))
+        });
+        let texture = (plugin.children.iter())
+            .find(|c| c.tag == "texture")
+            .or(referenced)
+            .ok_or_else(|| error("a \"bumpmap\" needs a nested <texture>".into()))?;
+        let height = read_texture(scene.file, scene.files, texture, self.warnings)?;
+        if !matches!(height, Texture::Bitmap(_)) {
+            return Err(error(
+                "a \"bumpmap\"'s texture must be a bitmap (its heights' gradient is a bitmap's)"
+                    .into(),
+            ));
+        }
+        let scale = plugin
+            .float("scale", 1.0)
+            .map_err(|(line, message)| InputError::at(self.scene.file, line, message))?;
+        Ok(TiltedNormals::BumpMap {
+            height: Arc::new(height),
+            scale: scale as f32,
+        })
+    }
+
     /// The texture `name` of `plugin`, which must have one.
     fn required_texture(
         &mut self,
         plugin: &Plugin,
         name: &str,
-    ) -> Result<Arc<crate::texture::Texture>, InputError> {
+    ) -> Result<Arc<Texture>, InputError> {
         match parameter_texture(plugin, name, self.scene, self.warnings)? {
             Some(texture) => Ok(Arc::new(texture)),
             None => Err(InputError::at(

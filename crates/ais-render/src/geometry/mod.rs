@@ -50,9 +50,12 @@ pub struct Hit {
     pub shape: u32,
     /// Texture coordinates (Mitsuba's conventions; zero on a mesh without them).
     pub uv: Vec2,
-    /// How the point moves with u (∂p/∂u, unnormalised): where a normal map's tangent space
-    /// points. Zero where there are no texture coordinates, or they are degenerate.
+    /// How the point moves with u (∂p/∂u, as Mitsuba defines it): where a normal map's
+    /// tangent space points. On a mesh without texture coordinates, the first edge (the
+    /// parameterisation is barycentric); zero where the coordinates are degenerate.
     pub dp_du: Vec3,
+    /// How the point moves with v (∂p/∂v), likewise.
+    pub dp_dv: Vec3,
 }
 
 /// Per-mesh data needed to shade a triangle hit.
@@ -313,19 +316,18 @@ impl Geometry {
         } else {
             1.0
         };
-        let (geometric_normal, shading_normal, uv, dp_du) = match &self.packed[index] {
+        let (geometric_normal, shading_normal, uv, [dp_du, dp_dv]) = match &self.packed[index] {
             Packed::Sphere(s) => {
                 let outward = (point - s.center).normalize();
-                // Mitsuba's sphere: u is the azimuth about z.
-                let dp_du = Vec3::new(-outward.y, outward.x, 0.0);
                 let uv = sphere_texcoords(outward);
-                (outward * flip, outward * flip, uv, dp_du)
+                let partials = sphere_partials(outward, s.radius);
+                (outward * flip, outward * flip, uv, partials)
             }
             Packed::Triangle([_, e1, e2]) => {
                 let n = e1.cross(*e2).normalize() * flip;
                 let shading = self.interpolated_normal(source, barycentrics).unwrap_or(n);
                 let uv = self.interpolated_texcoords(source, barycentrics);
-                (n, shading, uv, self.uv_tangent(source, *e1, *e2))
+                (n, shading, uv, self.uv_partials(source, *e1, *e2))
             }
         };
         Hit {
@@ -336,6 +338,7 @@ impl Geometry {
             shape: source.shape,
             uv,
             dp_du,
+            dp_dv,
         }
     }
 
@@ -352,20 +355,23 @@ impl Geometry {
             + texcoords[c as usize] * barycentrics.y
     }
 
-    /// ∂p/∂u over a triangle with edges `e1`, `e2` from its texture coordinates (zero when
-    /// its mesh has none, or they do not span the plane).
-    fn uv_tangent(&self, source: PrimitiveSource, e1: Vec3, e2: Vec3) -> Vec3 {
+    /// ∂p/∂u and ∂p/∂v over a triangle with edges `e1`, `e2`, from its texture coordinates
+    /// (the edges themselves when its mesh has none, zero when they do not span the plane).
+    fn uv_partials(&self, source: PrimitiveSource, e1: Vec3, e2: Vec3) -> [Vec3; 2] {
         let mesh = &self.meshes[source.mesh as usize];
         let Some(texcoords) = mesh.texcoords.as_ref() else {
-            return Vec3::ZERO;
+            return [e1, e2];
         };
         let [a, b, c] = mesh.triangles[source.index as usize].map(|i| texcoords[i as usize]);
         let (duv1, duv2) = (b - a, c - a);
         let determinant = duv1.x * duv2.y - duv1.y * duv2.x;
         if determinant.abs() <= f32::MIN_POSITIVE || !determinant.is_finite() {
-            return Vec3::ZERO;
+            return [Vec3::ZERO; 2];
         }
-        (e1 * duv2.y - e2 * duv1.y) / determinant
+        [
+            (e1 * duv2.y - e2 * duv1.y) / determinant,
+            (e2 * duv1.x - e1 * duv2.x) / determinant,
+        ]
     }
 
     /// The vertex normals of a triangle's mesh interpolated at `barycentrics` (None: the mesh
@@ -392,6 +398,21 @@ fn sphere_texcoords(outward: Vec3) -> Vec2 {
         u += 1.0;
     }
     Vec2::new(u, outward.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI)
+}
+
+/// ∂p/∂u and ∂p/∂v on a sphere of `radius` at the unit `outward` direction, for the texture
+/// coordinates of [`sphere_texcoords`] (Mitsuba's: 2π and π times the unit sphere's).
+fn sphere_partials(outward: Vec3, radius: f32) -> [Vec3; 2] {
+    let tau = std::f32::consts::TAU;
+    let dp_du = Vec3::new(-outward.y, outward.x, 0.0) * (tau * radius);
+    let planar = outward.x.hypot(outward.y);
+    let dp_dv = if planar > 0.0 {
+        let (cos_phi, sin_phi) = (outward.x / planar, outward.y / planar);
+        Vec3::new(outward.z * cos_phi, outward.z * sin_phi, -planar)
+    } else {
+        Vec3::X
+    };
+    [dp_du, dp_dv * (std::f32::consts::PI * radius)]
 }
 
 /// Centre and radius of a sphere enclosing every primitive (zero for none).

@@ -73,6 +73,7 @@ pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a
         geometric_normal: hit.geometric_normal,
         wo,
         dp_du: hit.dp_du,
+        dp_dv: hit.dp_dv,
     };
     let (bsdf, frame) = world.surfaces[hit.shape as usize].at(&point);
     GatherPoint {

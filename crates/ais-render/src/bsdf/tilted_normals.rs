@@ -1,8 +1,13 @@
-//! Mitsuba's `normalmap`: a material's shading normal tilted by a tangent-space texture.
+//! Mitsuba's `normalmap` and `bumpmap`: a material's shading normal tilted by a texture.
 //!
-//! At a hit, the texture's value c gives the normal n = 2c − 1 in the frame (s, t, n_s) of
-//! the surface, where s is ∂p/∂u made perpendicular to the shading normal n_s and
-//! t = n_s × s. As in Mitsuba:
+//! At a hit, the tilted normal n is expressed in the frame (s, t, n_s) of the surface, where
+//! s is ∂p/∂u made perpendicular to the shading normal n_s and t = n_s × s:
+//! - a normal map's value c gives n = 2c − 1;
+//! - a bump map's height h (times `scale`) moves the surface along n_s: its gradient
+//!   (h_u, h_v) replaces the normal component of ∂p/∂u and ∂p/∂v, n is their cross
+//!   product, turned to the geometric normal's side (Mitsuba's construction).
+//!
+//! Then, as in Mitsuba:
 //! - a normal that faces away from the viewer is mirrored about the frame's z axis
 //!   (`flip_invalid_normals`, default true);
 //! - a direction counts only where it lies on the same side of both normals;
@@ -14,9 +19,9 @@
 //! Behind a two-sided material the frame is mirrored through the surface first, as
 //! Mitsuba's `twosided` mirrors the directions.
 
-use super::ShadingFrame;
+use super::{ShadingFrame, SurfacePoint};
 use crate::geometry::basis;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// A tilt applied to a part's frame: what the unperturbed frame still decides.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,7 +32,7 @@ pub struct Tilt {
     alpha2: f32,
 }
 
-/// How a normal map is applied.
+/// How a normal or bump map is applied.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct NormalMapOptions {
     /// Mirror normals that face away from the viewer.
@@ -54,28 +59,51 @@ impl Tilt {
     }
 }
 
-/// The frame of a material seen from `wo`, `base` (its oriented frame at the hit, whose
-/// unoriented shading normal is `shading_normal`), tilted by the map's value `texel`; and
-/// the tilt that evaluating in it still needs.
-pub fn tilted_frame(
-    base: &ShadingFrame,
-    shading_normal: Vec3,
-    dp_du: Vec3,
-    texel: Vec3,
-    wo: Vec3,
-    options: NormalMapOptions,
-) -> (ShadingFrame, Tilt) {
+/// The unit tangent s and bitangent t of the frame that tilted normals are given in.
+fn tangent_frame(shading_normal: Vec3, dp_du: Vec3) -> (Vec3, Vec3) {
     let s = (dp_du - shading_normal * shading_normal.dot(dp_du)).normalize_or_zero();
     let s = if s == Vec3::ZERO {
         basis(shading_normal).0
     } else {
         s
     };
-    let t = shading_normal.cross(s);
+    (s, shading_normal.cross(s))
+}
+
+/// The normal a normal map's value `texel` gives, in the frame (s, t, n_s).
+pub fn normal_map_normal(texel: Vec3) -> Vec3 {
+    texel * 2.0 - Vec3::ONE
+}
+
+/// The normal a bump map gives at `point`, in the frame (s, t, n_s), from the gradient of
+/// its (scaled) height over (u, v).
+pub fn bump_map_normal(point: &SurfacePoint, gradient: Vec2) -> Vec3 {
+    let n = point.shading_normal;
+    let dp_du = point.dp_du + n * (gradient.x - n.dot(point.dp_du));
+    let dp_dv = point.dp_dv + n * (gradient.y - n.dot(point.dp_dv));
+    let mut bumped = dp_du.cross(dp_dv).normalize_or(n);
+    if point.geometric_normal.dot(bumped) < 0.0 {
+        bumped = -bumped;
+    }
+    let (s, t) = tangent_frame(n, point.dp_du);
+    Vec3::new(bumped.dot(s), bumped.dot(t), bumped.dot(n))
+}
+
+/// The frame of a material seen from `point.wo`, `base` (its oriented frame at the hit),
+/// tilted to `local` (a normal in the unoriented frame (s, t, n_s)); and the tilt that
+/// evaluating in it still needs.
+pub fn tilted_frame(
+    base: &ShadingFrame,
+    point: &SurfacePoint,
+    local: Vec3,
+    options: NormalMapOptions,
+) -> (ShadingFrame, Tilt) {
+    let (s, t) = tangent_frame(point.shading_normal, point.dp_du);
     // The viewer in the unperturbed frame, mirrored to the front behind a two-sided one.
+    let wo = point.wo;
     let wo_z = base.normal.dot(wo);
     let wo_local = Vec3::new(s.dot(wo), t.dot(wo), wo_z);
-    let mut local = texel * 2.0 - Vec3::ONE;
+    let mut local = local;
     if options.flip_invalid_normals && wo_z * wo_local.dot(local) <= 0.0 {
         local = Vec3::new(-local.x, -local.y, local.z);
     }
@@ -106,7 +134,32 @@ mod tests {
 
     fn frame_at(texel: Vec3, wo: Vec3) -> (ShadingFrame, Tilt) {
         let base = ShadingFrame::with_normal(Vec3::Z, Vec3::Z);
-        tilted_frame(&base, Vec3::Z, Vec3::new(2.0, 0.0, 0.3), texel, wo, MITSUBA)
+        let point = SurfacePoint {
+            uv: Vec2::ZERO,
+            shading_normal: Vec3::Z,
+            geometric_normal: Vec3::Z,
+            wo,
+            dp_du: Vec3::new(2.0, 0.0, 0.3),
+            dp_dv: Vec3::new(0.0, 1.0, 0.0),
+        };
+        tilted_frame(&base, &point, normal_map_normal(texel), MITSUBA)
+    }
+
+    #[test]
+    fn a_bump_leans_the_normal_against_the_slope() {
+        let point = SurfacePoint {
+            uv: Vec2::ZERO,
+            shading_normal: Vec3::Z,
+            geometric_normal: Vec3::Z,
+            wo: Vec3::Z,
+            dp_du: Vec3::X,
+            dp_dv: Vec3::Y,
+        };
+        // Height rising with u at slope 1: the normal leans 45° toward -u.
+        let local = bump_map_normal(&point, Vec2::new(1.0, 0.0));
+        let expected = Vec3::new(-1.0, 0.0, 1.0).normalize();
+        assert!((local - expected).length() < 1e-6, "{local}");
+        assert!(bump_map_normal(&point, Vec2::ZERO).abs_diff_eq(Vec3::Z, 1e-6));
     }
 
     #[test]
