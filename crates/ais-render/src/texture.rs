@@ -33,6 +33,8 @@ pub enum Texture {
     },
     /// An image.
     Bitmap(Box<Bitmap>),
+    /// Mitsuba's `rawconstant`: one value everywhere, taken as is (no colour conversion).
+    Constant(Vec3),
 }
 
 /// An image texture.
@@ -102,6 +104,7 @@ impl Texture {
                 }
             }
             Texture::Bitmap(bitmap) => bitmap.eval(bitmap.to_uv.apply(uv)),
+            Texture::Constant(value) => *value,
         }
     }
 
@@ -123,6 +126,7 @@ impl Texture {
                 return luminance(swapped.eval(uv));
             }
             Texture::Bitmap(bitmap) => bitmap.eval(bitmap.to_uv.apply(uv)),
+            Texture::Constant(value) => *value,
         };
         luminance(colour)
     }
@@ -131,7 +135,7 @@ impl Texture {
     /// zero for a checkerboard, which is flat almost everywhere.
     pub fn scalar_gradient(&self, uv: Vec2) -> Vec2 {
         match self {
-            Texture::Checkerboard { .. } => Vec2::ZERO,
+            Texture::Checkerboard { .. } | Texture::Constant(_) => Vec2::ZERO,
             Texture::Bitmap(bitmap) => bitmap.scalar_gradient(uv),
         }
     }
@@ -216,6 +220,7 @@ impl Wrap {
 fn known_properties(kind: &str) -> &'static [&'static str] {
     match kind {
         "checkerboard" => &["color0", "color1", "to_uv"],
+        "rawconstant" => &["value"],
         _ => &["filename", "filter_type", "wrap_mode", "raw", "to_uv"],
     }
 }
@@ -228,18 +233,24 @@ pub fn read_texture(
     warnings: &mut Vec<String>,
 ) -> Result<Texture, InputError> {
     let at = |(line, message): (u32, String)| InputError::at(file, line, message);
-    if !matches!(plugin.kind.as_str(), "checkerboard" | "bitmap") {
+    if !matches!(
+        plugin.kind.as_str(),
+        "checkerboard" | "bitmap" | "rawconstant"
+    ) {
         return Err(InputError::at(
             file,
             plugin.line,
             format!(
-                "texture type \"{}\" is not supported (checkerboard, bitmap)",
+                "texture type \"{}\" is not supported (checkerboard, bitmap, rawconstant)",
                 plugin.kind
             ),
         ));
     }
     crate::scene::warn_unknown(file, plugin, known_properties(&plugin.kind), warnings);
     let to_uv = UvTransform::from_mat4(plugin.transform("to_uv").map_err(at)?);
+    if plugin.kind == "rawconstant" {
+        return raw_constant(file, plugin);
+    }
     if plugin.kind == "checkerboard" {
         let colour = |name: &str, default: f32| colour_property(file, plugin, name, default);
         return Ok(Texture::Checkerboard {
@@ -250,6 +261,32 @@ pub fn read_texture(
     }
     let bitmap = read_bitmap(file, files, plugin, warnings)?;
     Ok(Texture::Bitmap(Box::new(Bitmap { to_uv, ..bitmap })))
+}
+
+/// A `rawconstant`'s `value`: a float, a vector or an rgb, taken as is (default 1).
+fn raw_constant(file: &Path, plugin: &Plugin) -> Result<Texture, InputError> {
+    use crate::scene::Property;
+    let value = match plugin.properties.get("value") {
+        None => Vec3::ONE,
+        Some(p) => match &p.value {
+            Property::Float(v) => Vec3::splat(*v as f32),
+            Property::Integer(v) => Vec3::splat(*v as f32),
+            Property::Vector(v) | Property::Point(v) => v.as_vec3(),
+            Property::Rgb(v) => glam::DVec3::from_array(*v).as_vec3(),
+            other => {
+                let message = format!(
+                    "\"value\" of a rawconstant must be a float, vector or rgb, not a {}",
+                    other.kind()
+                );
+                return Err(InputError::at(file, p.line, message));
+            }
+        },
+    };
+    if !value.is_finite() {
+        let message = "\"value\" of a rawconstant must be finite";
+        return Err(InputError::at(file, plugin.line, message));
+    }
+    Ok(Texture::Constant(value))
 }
 
 /// A constant colour of a texture (rgb or float; nested textures are refused).

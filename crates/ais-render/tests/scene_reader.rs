@@ -609,3 +609,24 @@ fn masks_blends_and_null_are_read_and_checked() {
         other => panic!("{other:?}"),
     }
 }
+
+#[test]
+fn a_raw_constant_texture_is_its_value() {
+    let text = r#"<scene version="3.0.0"><shape type="rectangle">
+        <bsdf type="blendbsdf">
+            <texture type="rawconstant" name="weight"><vector name="value" value="0.2, 0.4, 0.6"/></texture>
+            <bsdf type="diffuse"/><bsdf type="diffuse"/>
+        </bsdf></shape></scene>"#;
+    let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
+    let ais_render::bsdf::Surface::Blend { weight, .. } = world.surfaces[0].as_ref() else {
+        panic!("{:?}", world.surfaces[0]);
+    };
+    let luminance = 0.2 * 0.212_671 + 0.4 * 0.715_160 + 0.6 * 0.072_169;
+    assert!((weight.at(glam::Vec2::new(0.3, 0.7)) - luminance).abs() < 1e-6);
+    assert_world_refuses(
+        r#"<scene version="3.0.0"><shape type="rectangle"><bsdf type="mask">
+           <texture type="rawconstant" name="opacity"><string name="value" value="x"/></texture>
+           <bsdf type="diffuse"/></bsdf></shape></scene>"#,
+        "test.xml:2: \"value\" of a rawconstant must be a float, vector or rgb, not a string",
+    );
+}
