@@ -12,6 +12,7 @@ a flat (uncompressed) Radiance RGBE image. It also writes, into the same folder:
 - ball.obj: a smooth sphere of radius 1 with 7,920 triangles, an emitting mesh;
 - tiles.png: a 16 x 8 sRGB image of coloured tiles with a gradient, for bitmap textures;
 - bumps.png: a 64 x 64 tangent-space normal map of domes, for normalmap;
+- attributes.ply: a grid with a colour per vertex and a weight per face, for mesh_attribute;
 - quad.obj: a unit square with texture coordinates (OBJ's v up), for textured meshes;
 - shapes.serialized: Mitsuba's serialized format (version 4) with two shapes: a square with
   texture coordinates in single precision, and a pyramid with vertex normals in double
@@ -167,6 +168,35 @@ def bump_normal(x, y):
     return tuple(int(round((c / length * 0.5 + 0.5) * 255)) for c in n)
 
 
+def write_attribute_grid(path):
+    """An ASCII PLY grid of 8 x 8 squares over [-1, 1]^2 at z = 0 (2 triangles each), with a
+    colour per vertex (`red green blue`, a smooth gradient) and a weight per face
+    (`weight_0`, a checkerboard of 0.1 and 0.9), for mesh_attribute textures."""
+    n = 8
+    vertices = []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            x, y = -1 + 2 * i / n, -1 + 2 * j / n
+            colour = (0.2 + 0.7 * i / n, 0.3 + 0.5 * j / n, 0.9 - 0.6 * (i + j) / (2 * n))
+            vertices.append(f"{x:.6f} {y:.6f} 0 {colour[0]:.6f} {colour[1]:.6f} {colour[2]:.6f}")
+    faces = []
+    for j in range(n):
+        for i in range(n):
+            a, b = j * (n + 1) + i, j * (n + 1) + i + 1
+            c, d = b + n + 1, a + n + 1
+            weight = 0.9 if (i + j) % 2 == 0 else 0.1
+            faces.append(f"3 {a} {b} {c} {weight}")
+            faces.append(f"3 {a} {c} {d} {weight}")
+    header = ["ply", "format ascii 1.0", f"element vertex {len(vertices)}", "property float x",
+              "property float y", "property float z", "property float red", "property float green",
+              "property float blue", f"element face {len(faces)}",
+              "property list uchar int vertex_indices", "property float weight_0", "end_header"]
+    with open(path + ".tmp", "w") as f:
+        f.write("\n".join(header + vertices + faces) + "\n")
+    os.replace(path + ".tmp", path)
+    print(f"wrote {path}")
+
+
 def write_quad(path):
     """The square [-1, 1]^2 at z = 0 with texture coordinates running over [0, 2] x [0, 1]."""
     write_obj(path, ["v -1 -1 0", "v 1 -1 0", "v 1 1 0", "v -1 1 0",
@@ -220,6 +250,7 @@ def main():
     write_png(os.path.join(folder, "tiles.png"), 16, 8, tile)
     write_png(os.path.join(folder, "bumps.png"), 64, 64, bump_normal)
     write_quad(os.path.join(folder, "quad.obj"))
+    write_attribute_grid(os.path.join(folder, "attributes.ply"))
     write_blob(os.path.join(folder, "blob.obj"))
     write_leaves(os.path.join(folder, "leaves.obj"))
     write_ball(os.path.join(folder, "ball.obj"))

@@ -311,7 +311,7 @@ def suite_scenes():
 
 def ensure_assets():
     assets = os.path.join(ROOT, "scenes", "assets")
-    if not all(os.path.exists(os.path.join(assets, name)) for name in ("sky.hdr", "blob.obj", "leaves.obj", "ball.obj", "tiles.png", "bumps.png", "quad.obj",
+    if not all(os.path.exists(os.path.join(assets, name)) for name in ("sky.hdr", "blob.obj", "leaves.obj", "ball.obj", "tiles.png", "bumps.png", "attributes.ply", "quad.obj",
                                                                          "shapes.serialized")):
         subprocess.run([sys.executable, os.path.join(ROOT, "scenes", "make_assets.py")], check=True)
 

@@ -23,6 +23,7 @@ pub fn rectangle() -> TriangleMesh {
                 .to_vec(),
         ),
         triangles: vec![[0, 1, 2], [0, 2, 3]],
+        attributes: Vec::new(),
     }
 }
 

@@ -15,6 +15,7 @@
 
 use crate::error::InputError;
 use crate::image_io::{read_image, RgbImage};
+use crate::mesh::AttributeSite;
 use crate::scene::{ColourRole, FileResolver, Plugin};
 use glam::{DMat4, Vec2, Vec3};
 use std::path::Path;
@@ -35,6 +36,23 @@ pub enum Texture {
     Bitmap(Box<Bitmap>),
     /// Mitsuba's `rawconstant`: one value everywhere, taken as is (no colour conversion).
     Constant(Vec3),
+    /// Mitsuba's `mesh_attribute`: a mesh's per-vertex (interpolated) or per-face value,
+    /// times `scale`.
+    MeshAttribute {
+        /// The attribute's name, `vertex_…` or `face_…`.
+        name: String,
+        /// What the value is multiplied by.
+        scale: f32,
+    },
+}
+
+/// Where a texture is looked up.
+#[derive(Clone, Copy, Debug)]
+pub struct TextureLookup<'a> {
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// The mesh attributes there (None off meshes).
+    pub attributes: Option<AttributeSite<'a>>,
 }
 
 /// An image texture.
@@ -86,7 +104,40 @@ impl UvTransform {
 }
 
 impl Texture {
-    /// The texture's value at texture coordinates `uv`.
+    /// The texture's value at `at`: [`Texture::eval`], or a mesh attribute's value (zero
+    /// where the mesh has no such attribute).
+    #[inline]
+    pub fn eval_at(&self, at: &TextureLookup) -> Vec3 {
+        match self {
+            Texture::MeshAttribute { name, scale } => at
+                .attributes
+                .and_then(|site| site.value(name))
+                .map_or(Vec3::ZERO, |(value, _)| value * *scale),
+            other => other.eval(at.uv),
+        }
+    }
+
+    /// [`Texture::eval_scalar`] at `at`; a mesh attribute of one value gives it, of several
+    /// their luminance.
+    pub fn eval_scalar_at(&self, at: &TextureLookup) -> f32 {
+        match self {
+            Texture::MeshAttribute { name, scale } => at
+                .attributes
+                .and_then(|site| site.value(name))
+                .map_or(0.0, |(value, dimension)| {
+                    *scale
+                        * if dimension == 1 {
+                            value.x
+                        } else {
+                            luminance(value)
+                        }
+                }),
+            other => other.eval_scalar(at.uv),
+        }
+    }
+
+    /// The texture's value at texture coordinates `uv` (a mesh attribute needs
+    /// [`Texture::eval_at`]: zero here).
     #[inline]
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         match self {
@@ -105,6 +156,7 @@ impl Texture {
             }
             Texture::Bitmap(bitmap) => bitmap.eval(bitmap.to_uv.apply(uv)),
             Texture::Constant(value) => *value,
+            Texture::MeshAttribute { .. } => Vec3::ZERO,
         }
     }
 
@@ -127,6 +179,7 @@ impl Texture {
             }
             Texture::Bitmap(bitmap) => bitmap.eval(bitmap.to_uv.apply(uv)),
             Texture::Constant(value) => *value,
+            Texture::MeshAttribute { .. } => Vec3::ZERO,
         };
         luminance(colour)
     }
@@ -135,7 +188,9 @@ impl Texture {
     /// zero for a checkerboard, which is flat almost everywhere.
     pub fn scalar_gradient(&self, uv: Vec2) -> Vec2 {
         match self {
-            Texture::Checkerboard { .. } | Texture::Constant(_) => Vec2::ZERO,
+            Texture::Checkerboard { .. } | Texture::Constant(_) | Texture::MeshAttribute { .. } => {
+                Vec2::ZERO
+            }
             Texture::Bitmap(bitmap) => bitmap.scalar_gradient(uv),
         }
     }
@@ -221,6 +276,7 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
     match kind {
         "checkerboard" => &["color0", "color1", "to_uv"],
         "rawconstant" => &["value"],
+        "mesh_attribute" => &["name", "scale"],
         _ => &["filename", "filter_type", "wrap_mode", "raw", "to_uv"],
     }
 }
@@ -235,13 +291,14 @@ pub fn read_texture(
     let at = |(line, message): (u32, String)| InputError::at(file, line, message);
     if !matches!(
         plugin.kind.as_str(),
-        "checkerboard" | "bitmap" | "rawconstant"
+        "checkerboard" | "bitmap" | "rawconstant" | "mesh_attribute"
     ) {
         return Err(InputError::at(
             file,
             plugin.line,
             format!(
-                "texture type \"{}\" is not supported (checkerboard, bitmap, rawconstant)",
+                "texture type \"{}\" is not supported (checkerboard, bitmap, rawconstant, \
+                 mesh_attribute)",
                 plugin.kind
             ),
         ));
@@ -250,6 +307,9 @@ pub fn read_texture(
     let to_uv = UvTransform::from_mat4(plugin.transform("to_uv").map_err(at)?);
     if plugin.kind == "rawconstant" {
         return raw_constant(file, plugin);
+    }
+    if plugin.kind == "mesh_attribute" {
+        return mesh_attribute(file, plugin);
     }
     if plugin.kind == "checkerboard" {
         let colour = |name: &str, default: f32| colour_property(file, plugin, name, default);
@@ -261,6 +321,24 @@ pub fn read_texture(
     }
     let bitmap = read_bitmap(file, files, plugin, warnings)?;
     Ok(Texture::Bitmap(Box::new(Bitmap { to_uv, ..bitmap })))
+}
+
+/// A `mesh_attribute`: its `name` (required, `vertex_…` or `face_…`) and `scale`.
+fn mesh_attribute(file: &Path, plugin: &Plugin) -> Result<Texture, InputError> {
+    let at = |(line, message): (u32, String)| InputError::at(file, line, message);
+    let name = plugin
+        .string("name")
+        .map_err(at)?
+        .ok_or_else(|| InputError::at(file, plugin.line, "a mesh_attribute needs its \"name\""))?;
+    if !(name.starts_with("vertex_") || name.starts_with("face_")) {
+        let message = format!("mesh attribute \"{name}\" must start with vertex_ or face_");
+        return Err(InputError::at(file, plugin.line, message));
+    }
+    let scale = plugin.float("scale", 1.0).map_err(at)? as f32;
+    Ok(Texture::MeshAttribute {
+        name: name.to_string(),
+        scale,
+    })
 }
 
 /// A `rawconstant`'s `value`: a float, a vector or an rgb, taken as is (default 1).

@@ -91,6 +91,38 @@ impl ShapeSurfaces {
     }
 }
 
+/// Refuses a shape whose surface reads a mesh attribute that its mesh does not have.
+fn check_attributes(
+    file: &std::path::Path,
+    shape: &scene::ShapeDescription,
+    input: &ShapeInput,
+    surface: &Surface,
+) -> Result<(), InputError> {
+    let names = surface.attribute_names();
+    let available = match &input.geometry {
+        ShapeGeometry::Mesh(mesh) => mesh.attributes.iter().map(|a| a.name.as_str()).collect(),
+        ShapeGeometry::Sphere(_) => Vec::new(),
+    };
+    match names
+        .iter()
+        .find(|name| !available.contains(&name.as_str()))
+    {
+        None => Ok(()),
+        Some(name) => Err(InputError::at(
+            file,
+            shape.line,
+            format!(
+                "the shape has no mesh attribute \"{name}\" (it has: {})",
+                if available.is_empty() {
+                    "none".to_string()
+                } else {
+                    available.join(", ")
+                }
+            ),
+        )),
+    }
+}
+
 /// Whether `shape` is a sphere whose `to_world` rotates it.
 fn rotated_sphere(shape: &scene::ShapeDescription) -> bool {
     if !matches!(shape.geometry, scene::ShapeGeometry::Sphere { .. }) {
@@ -205,6 +237,7 @@ impl World {
         for (index, shape) in description.shapes.iter().enumerate() {
             surfaces.add(&description, shape, &mut warnings)?;
             let built = build_shape(&file, shape, index as u32, &mut warnings)?;
+            check_attributes(&file, shape, &built.input, &surfaces.per_shape[index])?;
             inputs.push(built.input);
             area_lights.extend(built.light);
         }

@@ -198,6 +198,7 @@ fn offset_rays_do_not_hit_the_surface_they_leave() {
         normals: None,
         texcoords: None,
         triangles: vec![[0, 1, 2]],
+        attributes: Vec::new(),
     };
     let geometry = Geometry::build(vec![
         ShapeInput {

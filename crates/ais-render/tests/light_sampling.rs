@@ -342,7 +342,7 @@ fn light_selection_mixture_fits() {
 }
 
 /// A tilted surface seen obliquely, where the proposal tests gather.
-fn surface_point() -> SurfacePoint {
+fn surface_point() -> SurfacePoint<'static> {
     let normal = Vec3::new(0.2, 0.1, 1.0).normalize();
     SurfacePoint {
         uv: glam::Vec2::ZERO,
@@ -351,6 +351,7 @@ fn surface_point() -> SurfacePoint {
         wo: Vec3::new(-0.3, 0.2, 1.0).normalize(),
         dp_du: Vec3::ZERO,
         dp_dv: Vec3::ZERO,
+        attributes: None,
     }
 }
 
@@ -523,6 +524,7 @@ fn mixture_sampling_fits_and_passes_light_through() {
             wo: *wo,
             dp_du: Vec3::ZERO,
             dp_dv: Vec3::ZERO,
+            attributes: None,
         };
         let surface = masked_blend();
         let (bsdf, _) = surface.at(&point);

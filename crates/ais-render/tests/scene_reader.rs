@@ -246,7 +246,9 @@ fn every_error_names_file_line_and_problem() {
         ("<scene><sensor type=\"thinlens\"/></scene>", "a thinlens sensor needs \"aperture_radius\""),
         ("<scene><sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/><float name=\"focus_distance\" value=\"0\"/></sensor></scene>", "focus_distance must be positive"),
         ("<scene><sensor type=\"perspective\"><float name=\"fov\" value=\"200\"/></sensor></scene>", "fov must be in (0, 180)"),
-        ("<scene><sensor type=\"perspective\"><string name=\"fov_axis\" value=\"z\"/></sensor></scene>", "unknown fov_axis"),
+        ("<scene><sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><string name=\"fov_axis\" value=\"z\"/></sensor></scene>", "unknown fov_axis"),
+        ("<scene><sensor type=\"perspective\"><float name=\"fov\" value=\"40\"/><string name=\"focal_length\" value=\"35mm\"/></sensor></scene>", "give either \"fov\" or \"focal_length\", not both"),
+        ("<scene><sensor type=\"perspective\"><string name=\"focal_length\" value=\"wide\"/></sensor></scene>", "focal_length \"wide\" must be a positive length in mm"),
         ("<scene><sensor type=\"perspective\"><film type=\"ldrfilm\"/></sensor></scene>", "film type \"ldrfilm\" is not supported"),
         ("<scene><sensor type=\"perspective\"><sampler type=\"independent\"><integer name=\"sample_count\" value=\"0\"/></sampler></sensor></scene>", "sample_count must be at least 1"),
         ("<scene><sensor type=\"perspective\"/><sensor type=\"perspective\"/></scene>", "only one <sensor>"),
@@ -386,7 +388,7 @@ fn texture_errors_name_file_line_and_problem() {
     let cases: Vec<(String, &str)> = vec![
         (
             shape("<bsdf type=\"diffuse\" id=\"b\">\n<texture type=\"noise\" name=\"reflectance\"/></bsdf>"),
-            "test.xml:2: texture type \"noise\" is not supported (checkerboard, bitmap)",
+            "test.xml:2: texture type \"noise\" is not supported (checkerboard, bitmap, rawconstant, mesh_attribute)",
         ),
         (
             shape("<bsdf type=\"diffuse\" id=\"b\">\n<texture type=\"bitmap\" name=\"reflectance\"/></bsdf>"),
@@ -622,11 +624,34 @@ fn a_raw_constant_texture_is_its_value() {
         panic!("{:?}", world.surfaces[0]);
     };
     let luminance = 0.2 * 0.212_671 + 0.4 * 0.715_160 + 0.6 * 0.072_169;
-    assert!((weight.at(glam::Vec2::new(0.3, 0.7)) - luminance).abs() < 1e-6);
+    let lookup = ais_render::texture::TextureLookup {
+        uv: glam::Vec2::new(0.3, 0.7),
+        attributes: None,
+    };
+    assert!((weight.at(&lookup) - luminance).abs() < 1e-6);
     assert_world_refuses(
         r#"<scene version="3.0.0"><shape type="rectangle"><bsdf type="mask">
            <texture type="rawconstant" name="opacity"><string name="value" value="x"/></texture>
            <bsdf type="diffuse"/></bsdf></shape></scene>"#,
         "test.xml:2: \"value\" of a rawconstant must be a float, vector or rgb, not a string",
+    );
+}
+
+#[test]
+fn a_missing_mesh_attribute_is_refused_with_those_there() {
+    let folder = common::shipped_scenes().expect("the scenes' assets");
+    let text = r#"<scene version="3.0.0">
+        <shape type="ply"><string name="filename" value="../assets/attributes.ply"/>
+            <bsdf type="diffuse"><texture type="mesh_attribute" name="reflectance">
+                <string name="name" value="vertex_colour"/></texture></bsdf></shape></scene>"#;
+    let file = folder.join("crosscheck").join("attributes-test.xml");
+    let description = parse_scene(&file, text, &[]).unwrap();
+    let Err(e) = ais_render::world::World::from_description(description) else {
+        panic!("a missing attribute must be refused");
+    };
+    let message = e.to_string();
+    assert!(
+        message.contains("attributes-test.xml:2: the shape has no mesh attribute \"vertex_colour\" (it has: vertex_color, face_weight)"),
+        "{message}"
     );
 }

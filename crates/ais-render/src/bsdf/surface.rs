@@ -6,7 +6,8 @@
 use super::hit::{HitBsdf, Mixture, MixturePart};
 use super::tilted_normals::{bump_map_normal, normal_map_normal, tilted_frame};
 use super::{Material, NormalMapOptions, ShadingFrame};
-use crate::texture::Texture;
+use crate::mesh::AttributeSite;
+use crate::texture::{Texture, TextureLookup};
 use glam::{Vec2, Vec3};
 use std::borrow::Cow;
 use std::sync::Arc;
@@ -70,7 +71,9 @@ impl TiltedNormals {
     /// The tilted normal at `point`, in the frame (s, t, n_s).
     fn local_normal(&self, point: &SurfacePoint) -> Vec3 {
         match self {
-            TiltedNormals::NormalMap(texture) => normal_map_normal(texture.eval(point.uv)),
+            TiltedNormals::NormalMap(texture) => {
+                normal_map_normal(texture.eval_at(&point.lookup()))
+            }
             TiltedNormals::BumpMap { height, scale } => {
                 bump_map_normal(point, *scale * height.scalar_gradient(point.uv))
             }
@@ -95,10 +98,10 @@ impl Fraction {
     }
 
     /// The share at texture coordinates `uv`.
-    pub fn at(&self, uv: Vec2) -> f32 {
+    pub fn at(&self, at: &TextureLookup) -> f32 {
         let value = match self {
             Fraction::Constant(value) => *value,
-            Fraction::Texture(texture) => texture.eval_scalar(uv),
+            Fraction::Texture(texture) => texture.eval_scalar_at(at),
         };
         if value.is_nan() {
             0.0
@@ -110,7 +113,7 @@ impl Fraction {
 
 /// The geometry a surface is resolved at.
 #[derive(Clone, Copy, Debug)]
-pub struct SurfacePoint {
+pub struct SurfacePoint<'a> {
     /// Texture coordinates.
     pub uv: Vec2,
     /// Interpolated shading normal.
@@ -123,6 +126,8 @@ pub struct SurfacePoint {
     pub dp_du: Vec3,
     /// ∂p/∂v.
     pub dp_dv: Vec3,
+    /// The mesh attributes there (None off meshes).
+    pub attributes: Option<AttributeSite<'a>>,
 }
 
 impl From<Material> for Surface {
@@ -149,6 +154,42 @@ impl Surface {
             Surface::Null => {}
         }
         self
+    }
+
+    /// The mesh attributes its textures read.
+    pub fn attribute_names(&self) -> Vec<String> {
+        let texture_names = |texture: &Texture| match texture {
+            Texture::MeshAttribute { name, .. } => vec![name.clone()],
+            _ => Vec::new(),
+        };
+        let fraction_names = |fraction: &Fraction| match fraction {
+            Fraction::Texture(texture) => texture_names(texture),
+            Fraction::Constant(_) => Vec::new(),
+        };
+        match self {
+            Surface::Material { albedo, .. } => albedo.as_deref().map_or(Vec::new(), texture_names),
+            Surface::Mask { opacity, inner } => {
+                [fraction_names(opacity), inner.attribute_names()].concat()
+            }
+            Surface::Blend {
+                weight,
+                first,
+                second,
+            } => [
+                fraction_names(weight),
+                first.attribute_names(),
+                second.attribute_names(),
+            ]
+            .concat(),
+            Surface::Tilted { normals, inner, .. } => {
+                let texture = match normals {
+                    TiltedNormals::NormalMap(texture) => texture,
+                    TiltedNormals::BumpMap { height, .. } => height,
+                };
+                [texture_names(texture), inner.attribute_names()].concat()
+            }
+            Surface::Null => Vec::new(),
+        }
     }
 
     /// Whether anything varies over the surface by texture coordinates.
@@ -182,7 +223,7 @@ impl Surface {
     pub fn at(&self, point: &SurfacePoint) -> (HitBsdf<'_>, ShadingFrame) {
         if let Surface::Material { material, albedo } = self {
             let material = match albedo {
-                Some(texture) => Cow::Owned(material.with_albedo(texture.eval(point.uv))),
+                Some(texture) => Cow::Owned(material.with_albedo(texture.eval_at(&point.lookup()))),
                 None => Cow::Borrowed(material),
             };
             let frame = point.frame(material.two_sided);
@@ -199,7 +240,7 @@ impl Surface {
         match self {
             Surface::Material { material, albedo } => {
                 let material = match albedo {
-                    Some(texture) => material.with_albedo(texture.eval(point.uv)),
+                    Some(texture) => material.with_albedo(texture.eval_at(&point.lookup())),
                     None => material.clone(),
                 };
                 let frame = point.frame(material.two_sided);
@@ -211,7 +252,7 @@ impl Surface {
                 });
             }
             Surface::Mask { opacity, inner } => {
-                let opacity = opacity.at(point.uv);
+                let opacity = opacity.at(&point.lookup());
                 inner.add_parts(point, share * opacity, mixture);
                 mixture.pass_through += share * (1.0 - opacity);
             }
@@ -220,7 +261,7 @@ impl Surface {
                 first,
                 second,
             } => {
-                let weight = weight.at(point.uv);
+                let weight = weight.at(&point.lookup());
                 first.add_parts(point, share * (1.0 - weight), mixture);
                 second.add_parts(point, share * weight, mixture);
             }
@@ -243,7 +284,15 @@ impl Surface {
     }
 }
 
-impl SurfacePoint {
+impl SurfacePoint<'_> {
+    /// Where textures are looked up here.
+    pub fn lookup(&self) -> TextureLookup<'_> {
+        TextureLookup {
+            uv: self.uv,
+            attributes: self.attributes,
+        }
+    }
+
     /// The shading frame here for a material that is (or not) two-sided.
     fn frame(&self, two_sided: bool) -> ShadingFrame {
         ShadingFrame::oriented(

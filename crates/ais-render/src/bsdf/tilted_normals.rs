@@ -141,6 +141,7 @@ mod tests {
             wo,
             dp_du: Vec3::new(2.0, 0.0, 0.3),
             dp_dv: Vec3::new(0.0, 1.0, 0.0),
+            attributes: None,
         };
         tilted_frame(&base, &point, normal_map_normal(texel), MITSUBA)
     }
@@ -154,6 +155,7 @@ mod tests {
             wo: Vec3::Z,
             dp_du: Vec3::X,
             dp_dv: Vec3::Y,
+            attributes: None,
         };
         // Height rising with u at slope 1: the normal leans 45° toward -u.
         let local = bump_map_normal(&point, Vec2::new(1.0, 0.0));

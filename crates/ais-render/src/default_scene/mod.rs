@@ -120,6 +120,7 @@ pub fn sculpture() -> TriangleMesh {
         normals: Some(normals),
         texcoords: None,
         triangles,
+        attributes: Vec::new(),
     }
 }
 

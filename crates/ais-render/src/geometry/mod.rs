@@ -12,7 +12,7 @@ use primitive::Packed;
 pub use primitive::{Primitive, Sphere, Triangle};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
 
-use crate::mesh::TriangleMesh;
+use crate::mesh::{AttributeSite, MeshAttribute, TriangleMesh};
 use glam::{Vec2, Vec3};
 use obvhs::cwbvh::CwBvh;
 use std::time::{Duration, Instant};
@@ -56,6 +56,10 @@ pub struct Hit {
     pub dp_du: Vec3,
     /// How the point moves with v (∂p/∂v), likewise.
     pub dp_dv: Vec3,
+    /// The primitive hit (its index among the geometry's primitives).
+    pub primitive: u32,
+    /// Barycentric coordinates of the point on a triangle (zero on a sphere).
+    pub barycentrics: Vec2,
 }
 
 /// Per-mesh data needed to shade a triangle hit.
@@ -64,6 +68,7 @@ struct MeshShading {
     normals: Option<Vec<Vec3>>,
     texcoords: Option<Vec<Vec2>>,
     triangles: Vec<[u32; 3]>,
+    attributes: Vec<MeshAttribute>,
 }
 
 /// The scene's primitives in a CWBVH.
@@ -162,6 +167,7 @@ impl Geometry {
                     normals: mesh.normals,
                     texcoords: mesh.texcoords,
                     triangles: mesh.triangles,
+                    attributes: mesh.attributes,
                 });
             }
         }
@@ -339,6 +345,8 @@ impl Geometry {
             uv,
             dp_du,
             dp_dv,
+            primitive: index as u32,
+            barycentrics,
         }
     }
 
@@ -353,6 +361,21 @@ impl Geometry {
         texcoords[a as usize] * (1.0 - barycentrics.x - barycentrics.y)
             + texcoords[b as usize] * barycentrics.x
             + texcoords[c as usize] * barycentrics.y
+    }
+
+    /// Where the mesh attributes of `hit`'s mesh are looked up (None on a sphere).
+    pub fn attribute_site(&self, hit: &Hit) -> Option<AttributeSite<'_>> {
+        let source = self.sources[hit.primitive as usize];
+        if !matches!(self.packed[hit.primitive as usize], Packed::Triangle(_)) {
+            return None;
+        }
+        let mesh = &self.meshes[source.mesh as usize];
+        Some(AttributeSite {
+            attributes: &mesh.attributes,
+            triangle: source.index as usize,
+            vertices: mesh.triangles[source.index as usize],
+            barycentrics: hit.barycentrics,
+        })
     }
 
     /// ∂p/∂u and ∂p/∂v over a triangle with edges `e1`, `e2`, from its texture coordinates

@@ -1,5 +1,6 @@
 //! Triangle meshes and their readers (OBJ, PLY, GLB).
 
+mod attributes;
 mod glb;
 mod obj;
 mod ply;
@@ -7,6 +8,7 @@ mod serialized;
 
 use crate::error::InputError;
 use crate::scene::MeshFormat;
+pub use attributes::{AttributeSite, MeshAttribute};
 use glam::{DMat4, Vec3};
 use std::path::Path;
 
@@ -21,6 +23,8 @@ pub struct TriangleMesh {
     pub texcoords: Option<Vec<glam::Vec2>>,
     /// Triangles as vertex indices.
     pub triangles: Vec<[u32; 3]>,
+    /// Named per-vertex and per-face values (PLY's other properties).
+    pub attributes: Vec<MeshAttribute>,
 }
 
 /// A mesh read from a file, with the problems found that did not stop the read.
@@ -93,6 +97,46 @@ fn usable<T>(attribute: &mut Option<Vec<T>>, vertices: usize, finite: impl Fn(&T
     !bad
 }
 
+/// Refuses attributes whose number of values does not match their elements.
+fn check_attributes(path: &Path, mesh: &TriangleMesh) -> Result<(), InputError> {
+    for attribute in &mesh.attributes {
+        let elements = if attribute.per_face() {
+            mesh.triangles.len()
+        } else {
+            mesh.positions.len()
+        };
+        if attribute.values.len() != elements * attribute.dimension {
+            let message = format!(
+                "attribute \"{}\" has {} values for {elements} elements of {}",
+                attribute.name,
+                attribute.values.len(),
+                attribute.dimension
+            );
+            return Err(InputError::new(path, message));
+        }
+    }
+    Ok(())
+}
+
+/// Keeps the triangles (and their face attributes) where `kept` says so.
+fn keep_triangles(mesh: &mut TriangleMesh, kept: &[bool]) {
+    let mut index = 0;
+    mesh.triangles.retain(|_| {
+        index += 1;
+        kept[index - 1]
+    });
+    for attribute in mesh.attributes.iter_mut().filter(|a| a.per_face()) {
+        let dimension = attribute.dimension;
+        let mut values = Vec::with_capacity(attribute.values.len());
+        for (chunk, keep) in attribute.values.chunks(dimension).zip(kept) {
+            if *keep {
+                values.extend_from_slice(chunk);
+            }
+        }
+        attribute.values = values;
+    }
+}
+
 /// The largest coordinate a scene may use, in world units: beyond it the BVH's single
 /// precision bounds lose every digit of a typical triangle.
 pub const LARGEST_COORDINATE: f32 = 1e12;
@@ -118,14 +162,18 @@ pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, Input
     }
     let before = mesh.triangles.len();
     let positions = &mesh.positions;
-    mesh.triangles.retain(|&[a, b, c]| {
-        let (a, b, c) = (
-            positions[a as usize],
-            positions[b as usize],
-            positions[c as usize],
-        );
-        (b - a).cross(c - a).length_squared() > 0.0
-    });
+    let kept: Vec<bool> = (mesh.triangles.iter())
+        .map(|&[a, b, c]| {
+            let (a, b, c) = (
+                positions[a as usize],
+                positions[b as usize],
+                positions[c as usize],
+            );
+            (b - a).cross(c - a).length_squared() > 0.0
+        })
+        .collect();
+    check_attributes(path, &mesh)?;
+    keep_triangles(&mut mesh, &kept);
     let dropped = before - mesh.triangles.len();
     if dropped > 0 {
         warnings.push(format!(

@@ -1,5 +1,6 @@
 //! Stanford PLY (ASCII and binary), through ply-rs-bw.
 
+use super::attributes::{group_properties, MeshAttribute};
 use super::TriangleMesh;
 use crate::error::InputError;
 use glam::{Vec2, Vec3};
@@ -61,7 +62,65 @@ fn read_vertices(
     if texcoords.len() == mesh.positions.len() && !texcoords.is_empty() {
         mesh.texcoords = Some(texcoords);
     }
+    mesh.attributes = read_attributes("vertex_", vertices, |_| 1);
     Ok(())
+}
+
+/// The properties a vertex or face holds that are not its geometry.
+const GEOMETRY: [&str; 16] = [
+    "x",
+    "y",
+    "z",
+    "nx",
+    "ny",
+    "nz",
+    "u",
+    "v",
+    "s",
+    "t",
+    "texture_u",
+    "texture_v",
+    "texture_s",
+    "texture_t",
+    "vertex_indices",
+    "vertex_index",
+];
+
+/// The attributes (named with `prefix`) that the elements' other numeric properties make,
+/// each element's value repeated `repeats(element)` times.
+fn read_attributes(
+    prefix: &str,
+    elements: &[DefaultElement],
+    repeats: impl Fn(usize) -> usize,
+) -> Vec<MeshAttribute> {
+    let Some(first) = elements.first() else {
+        return Vec::new();
+    };
+    let names: Vec<String> = (first.iter())
+        .filter(|(name, value)| {
+            !GEOMETRY.contains(&name.as_str()) && value.to_f32_lossy().is_some()
+        })
+        .map(|(name, _)| name.clone())
+        .collect();
+    let groups = group_properties(prefix, &names);
+    (groups.into_iter())
+        .map(|(name, indices)| {
+            let mut values = Vec::new();
+            for (index, element) in elements.iter().enumerate() {
+                let value: Vec<f32> = (indices.iter())
+                    .map(|&i| scalar(element, &names[i]).unwrap_or(0.0))
+                    .collect();
+                for _ in 0..repeats(index) {
+                    values.extend_from_slice(&value);
+                }
+            }
+            MeshAttribute {
+                name,
+                dimension: indices.len(),
+                values,
+            }
+        })
+        .collect()
 }
 
 /// The `face` element's polygons, fanned into triangles.
@@ -70,6 +129,7 @@ fn read_faces(
     faces: &[DefaultElement],
     mesh: &mut TriangleMesh,
 ) -> Result<(), InputError> {
+    let mut fanned = Vec::with_capacity(faces.len());
     for (index, face) in faces.iter().enumerate() {
         let property = face
             .get("vertex_indices")
@@ -92,7 +152,10 @@ fn read_faces(
         for k in 1..list.len() - 1 {
             mesh.triangles.push([list[0], list[k], list[k + 1]]);
         }
+        fanned.push(list.len() - 2);
     }
+    let attributes = read_attributes("face_", faces, |face| fanned[face]);
+    mesh.attributes.extend(attributes);
     Ok(())
 }
 

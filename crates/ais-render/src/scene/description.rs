@@ -184,7 +184,8 @@ pub struct SceneDescription {
 
 impl SceneDescription {
     /// A scene of nothing, with Mitsuba's defaults for what a file leaves out: its default
-    /// sensor (fov 39.3077° along x at the origin), a 768 × 576 film with the Gaussian
+    /// sensor (a 50 mm lens on a 36 × 24 mm sensor at the origin: 46.79° diagonally), a
+    /// 768 × 576 film with the Gaussian
     /// filter, and 4 samples per pixel.
     pub fn empty(file: &Path, files: FileResolver) -> Self {
         SceneDescription {
@@ -193,8 +194,8 @@ impl SceneDescription {
                 to_world: DMat4::IDENTITY,
                 projection: Projection::Perspective,
                 lens: None,
-                fov_degrees: 39.3077,
-                fov_axis: FovAxis::X,
+                fov_degrees: 2.0 * (36f64.hypot(24.0) / 100.0).atan().to_degrees(),
+                fov_axis: FovAxis::Diagonal,
             },
             resolution: (768, 576),
             filter: ReconstructionFilter::MITSUBA_DEFAULT,
@@ -363,9 +364,21 @@ fn read_sensor(
     Ok(())
 }
 
-/// A perspective sensor's `fov` (Mitsuba's default, 39.3077°) and `fov_axis`.
+/// A perspective sensor's field of view: `fov` and `fov_axis`, or, as Mitsuba does without
+/// a `fov`, the diagonal view of a 36 × 24 mm sensor behind a lens of `focal_length`
+/// (default `50mm`).
 fn read_fov(sensor: &Plugin) -> Result<(f64, FovAxis), (u32, String)> {
-    let fov = sensor.float("fov", 39.3077)?;
+    let has_fov = sensor.properties.contains_key("fov");
+    if has_fov && sensor.properties.contains_key("focal_length") {
+        return Err((
+            sensor.line,
+            "give either \"fov\" or \"focal_length\", not both".into(),
+        ));
+    }
+    if !has_fov {
+        return Ok((focal_length_fov(sensor)?, FovAxis::Diagonal));
+    }
+    let fov = sensor.float("fov", 0.0)?;
     if !(fov > 0.0 && fov < 180.0) {
         return Err((
             sensor.line,
@@ -381,6 +394,22 @@ fn read_fov(sensor: &Plugin) -> Result<(f64, FovAxis), (u32, String)> {
         other => return Err((sensor.line, format!("unknown fov_axis \"{other}\""))),
     };
     Ok((fov, fov_axis))
+}
+
+/// The diagonal field of view, in degrees, of a 36 × 24 mm sensor behind a lens of the
+/// sensor's `focal_length` (`50mm` by default; the `mm` is optional).
+fn focal_length_fov(sensor: &Plugin) -> Result<f64, (u32, String)> {
+    let text = sensor.string("focal_length")?.unwrap_or("50mm");
+    let millimetres = text.strip_suffix("mm").unwrap_or(text).trim();
+    match millimetres.parse::<f64>() {
+        Ok(f) if f > 0.0 && f.is_finite() => {
+            Ok(2.0 * (36f64.hypot(24.0) / (2.0 * f)).atan().to_degrees())
+        }
+        _ => Err((
+            sensor.line,
+            format!("focal_length \"{text}\" must be a positive length in mm, like \"50mm\""),
+        )),
+    }
 }
 
 /// The camera of a `perspective`, `thinlens` or `orthographic` sensor.

@@ -67,6 +67,7 @@ pub fn shipped_scenes() -> Result<PathBuf, String> {
         "ball.obj",
         "tiles.png",
         "bumps.png",
+        "attributes.ply",
         "quad.obj",
         "shapes.serialized",
     ];

@@ -74,6 +74,7 @@ pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a
         wo,
         dp_du: hit.dp_du,
         dp_dv: hit.dp_dv,
+        attributes: world.geometry.attribute_site(hit),
     };
     let (bsdf, frame) = world.surfaces[hit.shape as usize].at(&point);
     GatherPoint {
