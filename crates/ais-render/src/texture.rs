@@ -184,6 +184,23 @@ impl Texture {
         luminance(colour)
     }
 
+    /// The mean luminance over the unit square of texture coordinates (a light's power): a
+    /// bitmap's mean texel, a checkerboard's mean colour; zero for a mesh attribute.
+    pub fn mean_luminance(&self) -> f32 {
+        match self {
+            Texture::Checkerboard { color0, color1, .. } => luminance((*color0 + *color1) * 0.5),
+            Texture::Bitmap(bitmap) => {
+                let pixels = &bitmap.image.pixels;
+                let sum: f64 = (pixels.iter())
+                    .map(|p| luminance(Vec3::from(*p)) as f64)
+                    .sum();
+                (sum / pixels.len().max(1) as f64) as f32
+            }
+            Texture::Constant(value) => luminance(*value),
+            Texture::MeshAttribute { .. } => 0.0,
+        }
+    }
+
     /// The gradient of [`Texture::eval_scalar`] over (u, v) ([`Bitmap::scalar_gradient`]);
     /// zero for a checkerboard, which is flat almost everywhere.
     pub fn scalar_gradient(&self, uv: Vec2) -> Vec2 {

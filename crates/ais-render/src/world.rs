@@ -5,10 +5,11 @@ use crate::camera::Camera;
 use crate::error::InputError;
 use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
 use crate::lights::reader::{refuse_nested, scene_emitters, spectrum_property};
-use crate::lights::{AreaLight, AreaShape, Emitters, Lights, Rectangle};
+use crate::lights::{AreaLight, AreaShape, Emitters, Lights, MeshEmitter, Rectangle};
 use crate::mesh::{load_mesh, validate, TriangleMesh};
 use crate::scene::{self, SceneDescription};
 use crate::shapes;
+use crate::texture::Texture;
 use glam::Vec3;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -136,22 +137,69 @@ fn rotated_sphere(shape: &scene::ShapeDescription) -> bool {
         .any(|x| x.abs() > 1e-9 * scale.max(1.0))
 }
 
+/// What an area emitter sends from its front side: a radiance, times a texture's value
+/// over the surface when one gives it.
+#[derive(Clone, Debug)]
+pub struct Emission {
+    /// The radiance (one when a texture gives it).
+    pub radiance: Vec3,
+    /// The texture, if one gives the radiance.
+    pub texture: Option<Arc<Texture>>,
+}
+
+impl Emission {
+    /// The same radiance everywhere.
+    pub fn constant(radiance: Vec3) -> Self {
+        Emission {
+            radiance,
+            texture: None,
+        }
+    }
+}
+
+/// The emission of the area emitter `emitter`: its `radiance`, a colour or a texture
+/// (nested or referenced); any other nested plugin is refused.
+fn read_emission(
+    description: &SceneDescription,
+    emitter: &scene::Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<Emission, InputError> {
+    let file = &description.file;
+    scene::warn_unknown(file, emitter, &["radiance"], warnings);
+    let scene = TextureScene {
+        file,
+        files: &description.files,
+        bsdfs: &description.bsdfs,
+        textures: &description.textures,
+    };
+    let texture = crate::bsdf::parameter_texture(emitter, "radiance", &scene, warnings)?;
+    refuse_nested(file, emitter, &["radiance"])?;
+    Ok(match texture {
+        Some(texture) => Emission {
+            radiance: Vec3::ONE,
+            texture: Some(Arc::new(texture)),
+        },
+        None => Emission::constant(spectrum_property(file, emitter, "radiance")?),
+    })
+}
+
 /// An analytic sphere (centre, radius) under the shape's `to_world`, with its area light.
 fn sphere_shape(
     file: &std::path::Path,
     shape: &scene::ShapeDescription,
     (center, radius): (glam::DVec3, f64),
-    radiance: Option<Vec3>,
+    emission: Option<Emission>,
     index: u32,
 ) -> Result<BuiltShape, InputError> {
     let geometry = shapes::sphere(file, shape.line, center, radius, shape.to_world)?;
-    let light = match (radiance, &geometry) {
-        (Some(radiance), ShapeGeometry::Sphere(sphere)) => Some(AreaLight {
+    let light = match (emission, &geometry) {
+        (Some(emission), ShapeGeometry::Sphere(sphere)) => Some(AreaLight {
             shape: AreaShape::Sphere {
                 sphere: *sphere,
                 flipped: shape.flip_normals,
             },
-            radiance,
+            radiance: emission.radiance,
+            texture: emission.texture,
             shape_index: index,
         }),
         _ => None,
@@ -165,23 +213,18 @@ fn sphere_shape(
 
 /// Loads, transforms and validates shape number `index`, with its area light.
 fn build_shape(
-    file: &std::path::Path,
+    description: &SceneDescription,
     shape: &scene::ShapeDescription,
     index: u32,
     warnings: &mut Vec<String>,
 ) -> Result<BuiltShape, InputError> {
-    let radiance = shape
-        .emitter
-        .as_ref()
-        .map(|e| {
-            scene::warn_unknown(file, e, &["radiance"], warnings);
-            refuse_nested(file, e)?;
-            spectrum_property(file, e, "radiance")
-        })
+    let file = &description.file;
+    let emission = (shape.emitter.as_ref())
+        .map(|e| read_emission(description, e, warnings))
         .transpose()?;
     let mesh = match &shape.geometry {
         scene::ShapeGeometry::Sphere { center, radius } => {
-            return sphere_shape(file, shape, (*center, *radius), radiance, index)
+            return sphere_shape(file, shape, (*center, *radius), emission, index)
         }
         scene::ShapeGeometry::Rectangle => shapes::rectangle(),
         scene::ShapeGeometry::Disk => shapes::disk(),
@@ -203,13 +246,13 @@ fn build_shape(
         )
     })?;
     warnings.extend(checked.warnings);
-    let light = radiance.map(|radiance| {
+    let light = emission.map(|emission| {
         let is_rectangle = shape.geometry == scene::ShapeGeometry::Rectangle;
         area_light(
             &checked.mesh,
             is_rectangle,
             shape.flip_normals,
-            radiance,
+            emission,
             index,
         )
     });
@@ -236,7 +279,7 @@ impl World {
         let mut surfaces = ShapeSurfaces::default();
         for (index, shape) in description.shapes.iter().enumerate() {
             surfaces.add(&description, shape, &mut warnings)?;
-            let built = build_shape(&file, shape, index as u32, &mut warnings)?;
+            let built = build_shape(&description, shape, index as u32, &mut warnings)?;
             check_attributes(&file, shape, &built.input, &surfaces.per_shape[index])?;
             inputs.push(built.input);
             area_lights.extend(built.light);
@@ -303,7 +346,7 @@ pub fn area_light(
     mesh: &TriangleMesh,
     is_rectangle: bool,
     flip_normals: bool,
-    radiance: Vec3,
+    emission: Emission,
     shape_index: u32,
 ) -> AreaLight {
     if is_rectangle && mesh.positions.len() == 4 {
@@ -311,16 +354,28 @@ pub fn area_light(
         if let Some(rectangle) = Rectangle::new(p[0], p[1] - p[0], p[3] - p[0], flip_normals) {
             return AreaLight {
                 shape: AreaShape::Rectangle(rectangle),
-                radiance,
+                radiance: emission.radiance,
+                texture: emission.texture,
                 shape_index,
             };
         }
     }
-    AreaLight::from_triangles(
-        emitting_triangles(mesh, flip_normals),
-        radiance,
+    // Texture coordinates per triangle, in the light's order, only where a texture reads them.
+    let texcoords = (emission.texture.as_ref().zip(mesh.texcoords.as_ref())).map(|(_, uv)| {
+        (mesh.triangles.iter())
+            .map(|triangle| triangle.map(|i| uv[i as usize]))
+            .map(|[a, b, c]| if flip_normals { [a, c, b] } else { [a, b, c] })
+            .collect()
+    });
+    AreaLight {
+        shape: AreaShape::Triangles(Box::new(MeshEmitter::new(
+            emitting_triangles(mesh, flip_normals),
+            texcoords,
+        ))),
+        radiance: emission.radiance,
+        texture: emission.texture,
         shape_index,
-    )
+    }
 }
 
 /// The triangles of a mesh as a light, wound toward the emitting side.

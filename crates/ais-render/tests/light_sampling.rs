@@ -218,6 +218,7 @@ fn sphere_light_cone_sampling_fits() {
             flipped: false,
         },
         radiance: Vec3::ONE,
+        texture: None,
         shape_index: 0,
     };
     let point = Vec3::new(0.1, -0.2, 0.0);
@@ -243,6 +244,7 @@ fn a_distant_sphere_light_has_density_wherever_it_brings_light() {
             flipped: false,
         },
         radiance: Vec3::ONE,
+        texture: None,
         shape_index: 0,
     };
     let point = Vec3::new(-9.0, 0.0, -9.5);
@@ -311,6 +313,7 @@ fn mixed_lights() -> Lights {
             flipped: false,
         },
         radiance: Vec3::splat(5.0),
+        texture: None,
         shape_index: 1,
     };
     let env = Environment::Map(Box::new(EnvironmentMap::new(
@@ -674,6 +677,7 @@ fn solid_angle_rectangle() -> AreaLight {
     AreaLight {
         shape: AreaShape::Rectangle(rectangle),
         radiance: Vec3::ONE,
+        texture: None,
         shape_index: 0,
     }
 }
@@ -720,6 +724,7 @@ fn solid_angle_sampling_beats_area_sampling_near_a_rectangle_light() {
     let spherical = AreaLight {
         shape: AreaShape::Rectangle(Rectangle::new(corner, ex, ey, true).unwrap()),
         radiance: Vec3::ONE,
+        texture: None,
         shape_index: 0,
     };
     let triangles = vec![

@@ -311,7 +311,7 @@ fn emitter_errors_name_file_line_and_problem() {
         ("<scene>\n<emitter type=\"point\"><rgb name=\"intensity\" value=\"-1\"/></emitter></scene>", "test.xml:2: intensity must be finite and non-negative"),
         ("<scene>\n<emitter type=\"projector\"/></scene>", "test.xml:2: emitter type \"projector\" is not supported"),
         ("<scene><emitter type=\"spot\">\n<texture type=\"bitmap\" name=\"texture\"/></emitter></scene>", "test.xml:2: a nested <texture> in a \"spot\" emitter is not supported"),
-        ("<scene><shape type=\"cube\"><emitter type=\"area\">\n<texture type=\"checkerboard\" name=\"radiance\"/></emitter></shape></scene>", "test.xml:2: a nested <texture> in a \"area\" emitter is not supported"),
+        ("<scene><shape type=\"cube\"><emitter type=\"area\">\n<texture type=\"checkerboard\" name=\"glow\"/></emitter></shape></scene>", "test.xml:2: a nested <texture> in a \"area\" emitter is not supported (only an area light's radiance may be a texture)"),
     ];
     for (text, expected) in cases {
         assert_world_refuses(text, expected);

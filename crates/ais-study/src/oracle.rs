@@ -82,7 +82,7 @@ impl SampleIntegrator for Oracle {
         };
         let emitted = world
             .lights
-            .emitted(hit.shape, hit.geometric_normal, ray.direction);
+            .emitted(hit.shape, hit.geometric_normal, ray.direction, hit.uv);
         if world.lights.is_empty() {
             return emitted.to_array();
         }

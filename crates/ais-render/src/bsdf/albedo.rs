@@ -64,7 +64,7 @@ pub fn albedo_texture(
 
 /// The texture that gives `parameter` of `plugin`: a nested `<texture>` of that name, or a
 /// `<ref>` of that name to a top-level one.
-pub(super) fn parameter_texture(
+pub(crate) fn parameter_texture(
     plugin: &Plugin,
     parameter: &str,
     scene: &TextureScene,

@@ -14,6 +14,7 @@ mod surface;
 mod surface_reader;
 mod tilted_normals;
 
+pub(crate) use albedo::parameter_texture;
 pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
 pub use hit::{HitBsdf, Mixture, MixturePart};

@@ -15,8 +15,8 @@ use crate::lights::{AreaLight, AreaShape, Emitters, Environment, EnvironmentMap,
 use crate::mesh::TriangleMesh;
 use crate::scene::{look_at, CameraDescription, FovAxis, SceneDescription};
 use crate::shapes;
-use crate::world::area_light;
 use crate::world::World;
+use crate::world::{area_light, Emission};
 use glam::{DMat4, DVec3, Vec3};
 use std::f32::consts::{PI, TAU};
 
@@ -182,7 +182,7 @@ fn shapes_and_lights() -> (Vec<ShapeInput>, Vec<AreaLight>) {
     let panel_transform = look_at(PANEL_ORIGIN, PANEL_TARGET, DVec3::Y).expect("valid look-at")
         * DMat4::from_scale(DVec3::splat(PANEL_SCALE));
     let panel = shapes::rectangle().transformed(panel_transform, false, false);
-    let panel_light = area_light(&panel, true, false, PANEL_RADIANCE, 2);
+    let panel_light = area_light(&panel, true, false, Emission::constant(PANEL_RADIANCE), 2);
     let mesh = |mesh| ShapeInput {
         geometry: ShapeGeometry::Mesh(mesh),
         flip_normals: false,
@@ -204,6 +204,7 @@ fn shapes_and_lights() -> (Vec<ShapeInput>, Vec<AreaLight>) {
                 flipped: false,
             },
             radiance: light.radiance,
+            texture: None,
             shape_index: 3 + index as u32,
         });
     }

@@ -415,7 +415,7 @@ impl Geometry {
 /// Mitsuba's texture coordinates on a sphere at the unit `outward` direction from its
 /// centre: (azimuth about z / 2π, polar angle from +z / π). A sphere here keeps no rotation,
 /// so these are in world axes.
-fn sphere_texcoords(outward: Vec3) -> Vec2 {
+pub fn sphere_texcoords(outward: Vec3) -> Vec2 {
     let mut u = outward.y.atan2(outward.x) / std::f32::consts::TAU;
     if u < 0.0 {
         u += 1.0;

@@ -1,13 +1,18 @@
 //! Area lights: spheres (sampled uniformly inside the subtended cone), rectangles (by solid
 //! angle) and triangle meshes ([`MeshEmitter`]: area-weighted triangle choice, uniform points
 //! on the triangle, a BVH for densities and hits). Emission is one-sided, toward the surface normal, as in Mitsuba.
+//! A textured radiance is looked up at the emitting point's texture coordinates (Mitsuba's
+//! layouts on spheres and rectangles, the mesh's own elsewhere); sampling stays by solid
+//! angle or area, which any radiance keeps unbiased.
 
 use super::mesh_emitter::MeshEmitter;
 use super::spherical_rectangle::Rectangle;
 use super::Receiver;
-use crate::geometry::{Ray, Sphere, Triangle};
-use glam::Vec3;
+use crate::geometry::{sphere_texcoords, Ray, Sphere, Triangle};
+use crate::texture::Texture;
+use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
+use std::sync::Arc;
 
 /// The emitting surface.
 #[derive(Clone, Debug)]
@@ -36,6 +41,29 @@ pub struct AreaSample {
     pub distance: f32,
     /// The light's geometric normal there (toward its emitting side for a front face).
     pub normal: Vec3,
+    /// Which triangle of a mesh light, and where on it.
+    pub spot: LightSpot,
+}
+
+/// Where on a mesh light a point lies (unused by spheres and rectangles, whose texture
+/// coordinates follow from the point).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LightSpot {
+    /// The triangle's index in the light.
+    pub triangle: u32,
+    /// Barycentric coordinates of the point (of the second and third vertex).
+    pub barycentrics: Vec2,
+}
+
+/// The nearest point of an area light along a ray.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AreaHit {
+    /// Its distance.
+    pub distance: f32,
+    /// The light's geometric normal there.
+    pub normal: Vec3,
+    /// Which triangle of a mesh light.
+    pub spot: LightSpot,
 }
 
 /// An area light.
@@ -43,8 +71,10 @@ pub struct AreaSample {
 pub struct AreaLight {
     /// The surface.
     pub shape: AreaShape,
-    /// Emitted radiance (front side).
+    /// Emitted radiance (front side); a texture's value multiplies it.
     pub radiance: Vec3,
+    /// The texture that gives the radiance over the surface, if one does.
+    pub texture: Option<Arc<Texture>>,
     /// The geometry shape it belongs to.
     pub shape_index: u32,
 }
@@ -68,8 +98,9 @@ impl AreaLight {
     /// Triangles (wound toward the emitting side) as a light.
     pub fn from_triangles(triangles: Vec<Triangle>, radiance: Vec3, shape_index: u32) -> Self {
         AreaLight {
-            shape: AreaShape::Triangles(Box::new(MeshEmitter::new(triangles))),
+            shape: AreaShape::Triangles(Box::new(MeshEmitter::new(triangles, None))),
             radiance,
+            texture: None,
             shape_index,
         }
     }
@@ -81,16 +112,49 @@ impl AreaLight {
             AreaShape::Rectangle(rectangle) => rectangle.area(),
             AreaShape::Triangles(mesh) => mesh.area(),
         };
-        PI * super::luminance(self.radiance) as f64 * area
+        let mean = self
+            .texture
+            .as_ref()
+            .map_or(1.0, |t| t.mean_luminance() as f64);
+        PI * super::luminance(self.radiance) as f64 * mean * area
     }
 
-    /// Radiance leaving the light toward `-direction` at a point with geometric normal
-    /// `normal` (front side only).
-    pub fn emitted(&self, normal: Vec3, direction: Vec3) -> Vec3 {
-        if normal.dot(direction) < 0.0 {
-            self.radiance
-        } else {
-            Vec3::ZERO
+    /// Radiance leaving the light toward `-direction` at `point`, with geometric normal
+    /// `normal` (front side only), on triangle `spot` of a mesh light.
+    #[inline]
+    pub fn emitted(&self, normal: Vec3, direction: Vec3, point: Vec3, spot: LightSpot) -> Vec3 {
+        if normal.dot(direction) >= 0.0 {
+            return Vec3::ZERO;
+        }
+        match &self.texture {
+            None => self.radiance,
+            Some(texture) => self.radiance * texture.eval(self.texcoords(point, spot)),
+        }
+    }
+
+    /// [`AreaLight::emitted`] where the texture coordinates are known (a camera ray's hit).
+    pub fn emitted_at_uv(&self, normal: Vec3, direction: Vec3, uv: Vec2) -> Vec3 {
+        if normal.dot(direction) >= 0.0 {
+            return Vec3::ZERO;
+        }
+        match &self.texture {
+            None => self.radiance,
+            Some(texture) => self.radiance * texture.eval(uv),
+        }
+    }
+
+    /// The texture coordinates of `point` on the light (on triangle `spot` of a mesh).
+    fn texcoords(&self, point: Vec3, spot: LightSpot) -> Vec2 {
+        match &self.shape {
+            AreaShape::Sphere { sphere, .. } => {
+                sphere_texcoords((point - sphere.center).normalize_or(Vec3::Z))
+            }
+            AreaShape::Rectangle(rectangle) => {
+                let offset = point - rectangle.corner;
+                let along = |edge: Vec3| offset.dot(edge) / edge.length_squared();
+                Vec2::new(along(rectangle.edge_x), along(rectangle.edge_y))
+            }
+            AreaShape::Triangles(mesh) => mesh.texcoords(spot),
         }
     }
 
@@ -116,12 +180,13 @@ impl AreaLight {
                     .normalize();
                 // The point drawn is where the direction meets the sphere; at the rim, f32
                 // may miss it, and then nothing was drawn.
-                let (distance, normal) = self.intersect(&Ray::new(point, direction))?;
+                let hit = self.intersect(&Ray::new(point, direction))?;
                 Some(AreaSample {
                     direction,
                     pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
-                    distance,
-                    normal,
+                    distance: hit.distance,
+                    normal: hit.normal,
+                    spot: LightSpot::default(),
                 })
             }
             AreaShape::Rectangle(rectangle) => {
@@ -132,6 +197,7 @@ impl AreaLight {
                     pdf,
                     distance,
                     normal: rectangle.normal,
+                    spot: LightSpot::default(),
                 })
             }
             AreaShape::Triangles(mesh) => mesh.sample(point, u),
@@ -193,18 +259,21 @@ impl AreaLight {
         }
     }
 
-    /// The nearest point of the light along a ray: distance and the geometric normal there.
-    pub fn intersect(&self, ray: &Ray) -> Option<(f32, Vec3)> {
-        match &self.shape {
+    /// The nearest point of the light along a ray.
+    pub fn intersect(&self, ray: &Ray) -> Option<AreaHit> {
+        let (distance, normal) = match &self.shape {
             AreaShape::Sphere { sphere, flipped } => {
                 let t = sphere.intersect(ray, ray.t_max)?;
                 let n = (ray.at(t) - sphere.center).normalize();
-                Some((t, if *flipped { -n } else { n }))
+                (t, if *flipped { -n } else { n })
             }
-            AreaShape::Rectangle(rectangle) => {
-                rectangle.intersect(ray).map(|t| (t, rectangle.normal))
-            }
-            AreaShape::Triangles(mesh) => mesh.intersect(ray),
-        }
+            AreaShape::Rectangle(rectangle) => (rectangle.intersect(ray)?, rectangle.normal),
+            AreaShape::Triangles(mesh) => return mesh.intersect(ray),
+        };
+        Some(AreaHit {
+            distance,
+            normal,
+            spot: LightSpot::default(),
+        })
     }
 }

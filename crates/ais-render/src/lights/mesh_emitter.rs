@@ -6,10 +6,11 @@
 //! each crossing point, and the gather takes the radiance of the nearest one, so the
 //! density of a direction is the sum over all its crossings of distance² / (|cos| · area).
 
+use super::area::{AreaHit, LightSpot};
 use super::AreaSample;
 use crate::geometry::{Ray, Triangle};
 use ais::sampling::AliasTable;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use obvhs::cwbvh::CwBvh;
 use std::time::Duration;
 
@@ -23,16 +24,25 @@ pub struct MeshEmitter {
     /// Total area.
     area: f64,
     bvh: CwBvh,
+    /// Each triangle's texture coordinates at its vertices, in BVH order (for a textured
+    /// radiance).
+    texcoords: Option<Vec<[Vec2; 3]>>,
 }
 
 impl MeshEmitter {
-    /// The mesh of `triangles` (at least one).
-    pub fn new(triangles: Vec<Triangle>) -> Self {
+    /// The mesh of `triangles` (at least one), with their texture coordinates if a texture
+    /// gives the radiance.
+    pub fn new(triangles: Vec<Triangle>, texcoords: Option<Vec<[Vec2; 3]>>) -> Self {
         let bvh = obvhs::cwbvh::builder::build_cwbvh(
             &triangles,
             obvhs::BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
+        let texcoords = texcoords.map(|texcoords| {
+            (bvh.primitive_indices.iter())
+                .map(|&i| texcoords[i as usize])
+                .collect()
+        });
         let triangles: Vec<Triangle> = bvh
             .primitive_indices
             .iter()
@@ -47,7 +57,18 @@ impl MeshEmitter {
             area: areas.iter().sum(),
             triangles,
             bvh,
+            texcoords,
         }
+    }
+
+    /// The texture coordinates at `spot` (zero without them).
+    pub fn texcoords(&self, spot: LightSpot) -> Vec2 {
+        let Some(texcoords) = &self.texcoords else {
+            return Vec2::ZERO;
+        };
+        let [a, b, c] = texcoords[spot.triangle as usize];
+        let (u, v) = (spot.barycentrics.x, spot.barycentrics.y);
+        a * (1.0 - u - v) + b * u + c * v
     }
 
     /// Total area.
@@ -79,6 +100,10 @@ impl MeshEmitter {
             pdf,
             distance,
             normal,
+            spot: LightSpot {
+                triangle: index as u32,
+                barycentrics: Vec2::new(b1, b2),
+            },
         })
     }
 
@@ -114,21 +139,27 @@ impl MeshEmitter {
         density
     }
 
-    /// The nearest point of the mesh along `ray` (within `ray.t_max`): its distance and the
-    /// triangle's geometric normal there.
-    pub fn intersect(&self, ray: &Ray) -> Option<(f32, Vec3)> {
+    /// The nearest point of the mesh along `ray` (within `ray.t_max`).
+    pub fn intersect(&self, ray: &Ray) -> Option<AreaHit> {
         let mut hit = obvhs::ray::RayHit::none();
-        let mut nearest: Option<(f32, usize)> = None;
+        let mut nearest: Option<(f32, usize, Vec2)> = None;
         self.bvh
             .ray_traverse(ray.to_bvh(ray.t_max), &mut hit, |r, id| {
                 match self.triangles[id].intersect(ray, r.tmax) {
-                    Some((t, _)) => {
-                        nearest = Some((t, id));
+                    Some((t, barycentrics)) => {
+                        nearest = Some((t, id, barycentrics));
                         t
                     }
                     None => f32::INFINITY,
                 }
             });
-        nearest.map(|(t, id)| (t, self.triangles[id].normal().normalize()))
+        nearest.map(|(distance, id, barycentrics)| AreaHit {
+            distance,
+            normal: self.triangles[id].normal().normalize(),
+            spot: LightSpot {
+                triangle: id as u32,
+                barycentrics,
+            },
+        })
     }
 }

@@ -12,7 +12,7 @@ mod receiver;
 mod spherical_rectangle;
 mod toward;
 
-pub use area::{AreaLight, AreaSample, AreaShape};
+pub use area::{AreaHit, AreaLight, AreaSample, AreaShape, LightSpot};
 pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
@@ -126,9 +126,10 @@ impl Lights {
         if index < self.area.len() {
             let light = &self.area[index];
             let sample = light.sample_for(receiver, [u0, u[1]])?;
+            let target = receiver.point + sample.direction * sample.distance;
             let point = AreaPoint {
-                target: receiver.point + sample.direction * sample.distance,
-                radiance: light.emitted(sample.normal, sample.direction),
+                target,
+                radiance: light.emitted(sample.normal, sample.direction, target, sample.spot),
                 density: self.choice_probability(index) * sample.pdf,
             };
             return Some(Toward::area(sample.direction, point));
@@ -271,15 +272,17 @@ impl Lights {
             .area
             .iter()
             .enumerate()
-            .filter_map(|(index, light)| light.intersect(&ray).map(|(t, n)| (t, n, index)))
-            .min_by(|a, b| a.0.total_cmp(&b.0));
+            .filter_map(|(index, light)| light.intersect(&ray).map(|hit| (hit, index)))
+            .min_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
         toward.source = match nearest {
-            Some((distance, normal, index)) => {
+            Some((hit, index)) => {
                 let light = &self.area[index];
-                let density = light.density_at(receiver, toward.direction, distance, normal);
+                let density =
+                    light.density_at(receiver, toward.direction, hit.distance, hit.normal);
+                let target = receiver.point + toward.direction * hit.distance;
                 Source::Area(AreaPoint {
-                    target: receiver.point + toward.direction * distance,
-                    radiance: light.emitted(normal, toward.direction),
+                    target,
+                    radiance: light.emitted(hit.normal, toward.direction, target, hit.spot),
                     density: self.choice_probability(index) * density,
                 })
             }
@@ -296,10 +299,10 @@ impl Lights {
     }
 
     /// Radiance emitted toward `-direction` by shape `shape` at a point with geometric
-    /// normal `normal` (zero if the shape is not an emitter).
-    pub fn emitted(&self, shape: u32, normal: Vec3, direction: Vec3) -> Vec3 {
+    /// normal `normal` and texture coordinates `uv` (zero if the shape is not an emitter).
+    pub fn emitted(&self, shape: u32, normal: Vec3, direction: Vec3, uv: glam::Vec2) -> Vec3 {
         match self.shape_lights.get(shape as usize).copied().flatten() {
-            Some(index) => self.area[index].emitted(normal, direction),
+            Some(index) => self.area[index].emitted_at_uv(normal, direction, uv),
             None => Vec3::ZERO,
         }
     }

@@ -22,7 +22,7 @@ pub(crate) fn scene_emitters(
     let mut environment_found: Option<Environment> = None;
     let mut delta = Vec::new();
     for plugin in plugins {
-        refuse_nested(file, plugin)?;
+        refuse_nested(file, plugin, &[])?;
         match plugin.kind.as_str() {
             "point" | "spot" | "directional" => delta.push(delta_light(file, plugin, warnings)?),
             _ if environment_found.is_some() => {
@@ -38,15 +38,25 @@ pub(crate) fn scene_emitters(
     Ok((environment_found, delta))
 }
 
-/// Refuses an emitter with nested plugins (a textured radiance or intensity, a spot's
-/// texture): they would otherwise be dropped without a word.
-pub(crate) fn refuse_nested(file: &Path, plugin: &Plugin) -> Result<(), InputError> {
-    match plugin.children.first() {
+/// Refuses an emitter with nested plugins other than those filling `allowed` (a textured
+/// intensity, a spot's texture): they would otherwise be dropped without a word.
+pub(crate) fn refuse_nested(
+    file: &Path,
+    plugin: &Plugin,
+    allowed: &[&str],
+) -> Result<(), InputError> {
+    let refused = (plugin.children.iter()).find(|c| {
+        !c.name
+            .as_deref()
+            .is_some_and(|name| allowed.contains(&name))
+    });
+    match refused {
         Some(child) => Err(InputError::at(
             file,
             child.line,
             format!(
-                "a nested <{}> in a \"{}\" emitter is not supported (textured emitters are not)",
+                "a nested <{}> in a \"{}\" emitter is not supported (only an area light's \
+                 radiance may be a texture)",
                 child.tag, plugin.kind
             ),
         )),

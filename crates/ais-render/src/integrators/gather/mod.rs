@@ -282,7 +282,7 @@ pub fn gather<P: BatchProbe>(
     } else {
         world
             .lights
-            .emitted(hit.shape, hit.geometric_normal, ray.direction)
+            .emitted(hit.shape, hit.geometric_normal, ray.direction, hit.uv)
     };
     if world.lights.is_empty() {
         return emitted;
