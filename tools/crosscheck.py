@@ -116,11 +116,11 @@ def mitsuba_scene_text(text, width, height, samples):
     return text
 
 
-# Mitsuba 3.9.1's `direct` weighs every emitter sample of a point, spot or directional light
+# Mitsuba 3.9.1's `direct` weighs every emitter sample of a point, spot, projector or directional light
 # by 1 instead of 1 / emitter_samples, so such scenes come out emitter_samples times too
 # bright (measured: 8.0x at 8 samples). With them, Mitsuba runs one emitter and one BSDF
 # sample per camera sample, and as many more camera samples: the same work, the right weights.
-DELTA_EMITTER = re.compile(r'<emitter\s+type="(point|spot|directional)"')
+DELTA_EMITTER = re.compile(r'<emitter\b[^>]*\btype="(point|spot|directional|projector)"')
 
 
 INCLUDE = re.compile(r'<include\s+filename="([^"]+)"\s*/>')

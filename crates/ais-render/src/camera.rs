@@ -19,7 +19,7 @@ pub struct Camera {
 }
 
 /// tan(half field of view) along x and y of a perspective camera with this aspect.
-fn perspective_half(description: &CameraDescription, aspect: f64) -> (f64, f64) {
+pub(crate) fn perspective_half(description: &CameraDescription, aspect: f64) -> (f64, f64) {
     let tan = (description.fov_degrees.to_radians() / 2.0).tan();
     let axis = match description.fov_axis {
         FovAxis::Smaller if aspect >= 1.0 => FovAxis::Y,

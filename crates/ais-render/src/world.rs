@@ -294,12 +294,13 @@ impl World {
         crate::limits::check_geometry_memory(triangles)
             .map_err(|message| InputError::new(&file, message))?;
         let geometry = Geometry::build(inputs);
-        let (environment, delta) = scene_emitters(
-            &file,
-            &description.files,
-            &description.emitters,
-            &mut warnings,
-        )?;
+        let scene = TextureScene {
+            file: &file,
+            files: &description.files,
+            bsdfs: &description.bsdfs,
+            textures: &description.textures,
+        };
+        let (environment, delta) = scene_emitters(&scene, &description.emitters, &mut warnings)?;
         let (_, radius) = geometry.bounding_sphere();
         let emitters = Emitters {
             environment,

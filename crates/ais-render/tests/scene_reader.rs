@@ -309,8 +309,10 @@ fn emitter_errors_name_file_line_and_problem() {
         ("<scene>\n<emitter type=\"point\"><point name=\"position\" x=\"nan\" y=\"0\" z=\"0\"/></emitter></scene>", "test.xml:2: point emitter: position or direction is not finite"),
         ("<scene>\n<emitter type=\"directional\"><vector name=\"direction\" x=\"0\" y=\"0\" z=\"0\"/></emitter></scene>", "test.xml:2: directional light has no direction"),
         ("<scene>\n<emitter type=\"point\"><rgb name=\"intensity\" value=\"-1\"/></emitter></scene>", "test.xml:2: intensity must be finite and non-negative"),
-        ("<scene>\n<emitter type=\"projector\"/></scene>", "test.xml:2: emitter type \"projector\" is not supported"),
-        ("<scene><emitter type=\"spot\">\n<texture type=\"bitmap\" name=\"texture\"/></emitter></scene>", "test.xml:2: a nested <texture> in a \"spot\" emitter is not supported"),
+        ("<scene>\n<emitter type=\"irradiancemeter\"/></scene>", "test.xml:2: emitter type \"irradiancemeter\" is not supported"),
+        ("<scene><emitter type=\"spot\">\n<texture type=\"bitmap\" name=\"pattern\"/></emitter></scene>", "test.xml:2: a nested <texture> in a \"spot\" emitter is not supported"),
+        ("<scene>\n<emitter type=\"spot\"><float name=\"cutoff_angle\" value=\"95\"/><texture type=\"checkerboard\" name=\"texture\"/></emitter></scene>", "test.xml:2: a textured spot's cutoff_angle must be below 90 degrees"),
+        ("<scene>\n<emitter type=\"projector\"><float name=\"scale\" value=\"-1\"/></emitter></scene>", "test.xml:2: projector scale must be finite and non-negative"),
         ("<scene><shape type=\"cube\"><emitter type=\"area\">\n<texture type=\"checkerboard\" name=\"glow\"/></emitter></shape></scene>", "test.xml:2: a nested <texture> in a \"area\" emitter is not supported (only an area light's radiance may be a texture)"),
     ];
     for (text, expected) in cases {

@@ -1,30 +1,42 @@
 //! Scene-level emitters read from their plugins, with Mitsuba's parameters and defaults:
 //! `envmap` and `constant` (the environment: at most one), and any number of `point`,
-//! `spot` and `directional` lights.
+//! `spot` (with its texture), `projector` and `directional` lights.
 
+use super::delta::Projector;
 use super::{DeltaLight, Environment, EnvironmentMap, Spot};
+use crate::bsdf::{parameter_texture, TextureScene};
 use crate::error::InputError;
 use crate::image_io::read_image;
 use crate::scene::{self, ColourRole, FileResolver, Plugin};
+use crate::texture::Texture;
 use glam::{DMat3, DVec3, Vec3};
 use std::path::Path;
+use std::sync::Arc;
 
 /// The emitter types a scene may hold outside shapes.
-const SUPPORTED: &str = "envmap, constant, point, spot, directional; area inside a shape";
+const SUPPORTED: &str =
+    "envmap, constant, point, spot, projector, directional; area inside a shape";
 
-/// The scene-level emitters of a scene: its environment and its delta lights.
+/// The scene-level emitters of `scene`'s file: its environment and its delta lights.
 pub(crate) fn scene_emitters(
-    file: &Path,
-    files: &FileResolver,
+    scene: &TextureScene,
     plugins: &[Plugin],
     warnings: &mut Vec<String>,
 ) -> Result<(Option<Environment>, Vec<DeltaLight>), InputError> {
+    let (file, files) = (scene.file, scene.files);
     let mut environment_found: Option<Environment> = None;
     let mut delta = Vec::new();
     for plugin in plugins {
-        refuse_nested(file, plugin, &[])?;
+        let textured: &[&str] = match plugin.kind.as_str() {
+            "spot" => &["texture"],
+            "projector" => &["irradiance"],
+            _ => &[],
+        };
+        refuse_nested(file, plugin, textured)?;
         match plugin.kind.as_str() {
-            "point" | "spot" | "directional" => delta.push(delta_light(file, plugin, warnings)?),
+            "point" | "directional" => delta.push(delta_light(file, plugin, warnings)?),
+            "spot" => delta.push(spot(scene, plugin, warnings)?),
+            "projector" => delta.push(projector(scene, plugin, warnings)?),
             _ if environment_found.is_some() => {
                 return Err(InputError::at(
                     file,
@@ -74,7 +86,6 @@ fn delta_light(
     let to_world = plugin.transform("to_world").map_err(at)?;
     let known: &[&str] = match plugin.kind.as_str() {
         "point" => &["intensity", "position", "to_world"],
-        "spot" => &["intensity", "cutoff_angle", "beam_width", "to_world"],
         _ => &["irradiance", "direction", "to_world"],
     };
     scene::warn_unknown(file, plugin, known, warnings);
@@ -87,7 +98,6 @@ fn delta_light(
                 intensity: spectrum_property(file, plugin, "intensity")?,
             })
         }
-        "spot" => spot(file, plugin, to_world),
         _ => {
             let along_z = to_world.transform_vector3(DVec3::Z);
             let travel = plugin.point("direction", along_z).map_err(at)?;
@@ -108,9 +118,17 @@ fn delta_light(
 }
 
 /// A `spot` emitter: angles in degrees, the beam width three quarters of the cutoff unless
-/// given, the axis along `to_world`'s +z.
-fn spot(file: &Path, plugin: &Plugin, to_world: glam::DMat4) -> Result<DeltaLight, InputError> {
+/// given, the axis along `to_world`'s +z, and the texture spread over the cone if it has one.
+fn spot(
+    scene: &TextureScene,
+    plugin: &Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<DeltaLight, InputError> {
+    let file = scene.file;
     let at = |(line, message): (u32, String)| InputError::at(file, line, message);
+    let known = ["intensity", "cutoff_angle", "beam_width", "to_world"];
+    scene::warn_unknown(file, plugin, &known, warnings);
+    let to_world = plugin.transform("to_world").map_err(at)?;
     let cutoff = plugin.float("cutoff_angle", 20.0).map_err(at)?;
     let beam = plugin.float("beam_width", cutoff * 0.75).map_err(at)?;
     if !(cutoff.is_finite() && beam.is_finite() && cutoff > 0.0 && cutoff <= 180.0 && beam >= 0.0) {
@@ -120,21 +138,87 @@ fn spot(file: &Path, plugin: &Plugin, to_world: glam::DMat4) -> Result<DeltaLigh
             "spot angles must be finite, with 0 < cutoff_angle <= 180 and beam_width >= 0",
         ));
     }
-    let rotation = DMat3::from_mat4(to_world);
-    if rotation.determinant().abs() < 1e-12 {
-        return Err(InputError::at(
-            file,
-            plugin.line,
-            "spot to_world is singular",
-        ));
+    let (position, to_local) = pinhole_frame(file, plugin, to_world)?;
+    let texture = parameter_texture(plugin, "texture", scene, warnings)?;
+    if texture.is_some() && cutoff >= 90.0 {
+        let message = "a textured spot's cutoff_angle must be below 90 degrees";
+        return Err(InputError::at(file, plugin.line, message));
     }
-    let position = to_world.transform_point3(DVec3::ZERO);
     Ok(DeltaLight::Spot(Spot {
-        position: finite_point(file, plugin, position)?,
+        position,
         intensity: spectrum_property(file, plugin, "intensity")?,
-        to_local: rotation.inverse().as_mat3(),
+        to_local: to_local.as_mat3(),
         cutoff_angle: cutoff.to_radians() as f32,
         beam_width: beam.min(cutoff).to_radians() as f32,
+        texture: texture.map(Arc::new),
+    }))
+}
+
+/// Where a spot or projector sits and its world-to-local rotation, from `to_world` (which
+/// must be invertible, with a finite origin).
+fn pinhole_frame(
+    file: &Path,
+    plugin: &Plugin,
+    to_world: glam::DMat4,
+) -> Result<(Vec3, DMat3), InputError> {
+    let rotation = DMat3::from_mat4(to_world);
+    if rotation.determinant().abs() < 1e-12 {
+        let message = format!("{} to_world is singular", plugin.kind);
+        return Err(InputError::at(file, plugin.line, message));
+    }
+    let position = to_world.transform_point3(DVec3::ZERO);
+    Ok((finite_point(file, plugin, position)?, rotation.inverse()))
+}
+
+/// A `projector`: its `irradiance` image (a texture, or a colour: a 1 × 1 image), `scale`,
+/// and field of view (`fov` and `fov_axis`, or `focal_length`) over the image's aspect.
+fn projector(
+    scene: &TextureScene,
+    plugin: &Plugin,
+    warnings: &mut Vec<String>,
+) -> Result<DeltaLight, InputError> {
+    let file = scene.file;
+    let at = |(line, message): (u32, String)| InputError::at(file, line, message);
+    let known = [
+        "irradiance",
+        "scale",
+        "to_world",
+        "fov",
+        "fov_axis",
+        "focal_length",
+    ];
+    scene::warn_unknown(file, plugin, &known, warnings);
+    let to_world = plugin.transform("to_world").map_err(at)?;
+    let (position, _) = pinhole_frame(file, plugin, to_world)?;
+    let irradiance = match parameter_texture(plugin, "irradiance", scene, warnings)? {
+        Some(texture) => texture,
+        None => Texture::Constant(spectrum_property(file, plugin, "irradiance")?),
+    };
+    let aspect = match &irradiance {
+        Texture::Bitmap(bitmap) => bitmap.image.width as f64 / bitmap.image.height as f64,
+        _ => 1.0,
+    };
+    let (fov_degrees, fov_axis) = scene::read_fov(plugin).map_err(at)?;
+    let camera = scene::CameraDescription {
+        to_world: glam::DMat4::IDENTITY,
+        projection: scene::Projection::Perspective,
+        lens: None,
+        fov_degrees,
+        fov_axis,
+    };
+    let (half_x, half_y) = crate::camera::perspective_half(&camera, aspect);
+    let scale = plugin.float("scale", 1.0).map_err(at)? as f32;
+    if !(scale.is_finite() && scale >= 0.0) {
+        let message = "projector scale must be finite and non-negative";
+        return Err(InputError::at(file, plugin.line, message));
+    }
+    Ok(DeltaLight::Projector(Projector {
+        position,
+        to_local: to_world.inverse().as_mat4(),
+        axis: to_world.transform_vector3(DVec3::Z).as_vec3(),
+        half: glam::Vec2::new(half_x as f32, half_y as f32),
+        irradiance: Arc::new(irradiance),
+        scale,
     }))
 }
 

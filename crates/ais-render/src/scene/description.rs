@@ -367,7 +367,7 @@ fn read_sensor(
 /// A perspective sensor's field of view: `fov` and `fov_axis`, or, as Mitsuba does without
 /// a `fov`, the diagonal view of a 36 × 24 mm sensor behind a lens of `focal_length`
 /// (default `50mm`).
-fn read_fov(sensor: &Plugin) -> Result<(f64, FovAxis), (u32, String)> {
+pub(crate) fn read_fov(sensor: &Plugin) -> Result<(f64, FovAxis), (u32, String)> {
     let has_fov = sensor.properties.contains_key("fov");
     if has_fov && sensor.properties.contains_key("focal_length") {
         return Err((

@@ -7,11 +7,11 @@ mod properties;
 mod spectrum;
 mod xml;
 
-pub(crate) use description::warn_unknown;
 pub use description::{
     load_scene, parse_scene, CameraDescription, FovAxis, MeshFormat, Projection, SceneDescription,
     ShapeDescription, ShapeGeometry, ThinLens,
 };
+pub(crate) use description::{read_fov, warn_unknown};
 pub use file_resolver::FileResolver;
 pub use properties::{LocatedProperty, Plugin, Property};
 pub use spectrum::{ColourRole, SampledSpectrum, Spectrum};
