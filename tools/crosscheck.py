@@ -87,6 +87,23 @@ def setup_venv(venv):
     return python
 
 
+def outer_element(text, tag):
+    """The span of the first <tag> element with everything nested in it (integrators nest:
+    `moment` around `path`), or None."""
+    start = re.search(rf"<{tag}\b", text)
+    if not start:
+        return None
+    depth = 0
+    for token in re.finditer(rf"<{tag}\b[^>]*?(/?)>|</{tag}\s*>", text[start.start():]):
+        if token.group(0).startswith("</"):
+            depth -= 1
+        elif token.group(1) != "/":
+            depth += 1
+        if depth == 0:
+            return start.start(), start.start() + token.end()
+    return None
+
+
 def mitsuba_scene_text(text, width, height, samples):
     """The scene for Mitsuba: its `direct` integrator (keeping the scene's hide_emitters) and
     our film size; the reconstruction filter stays the scene's."""
@@ -95,9 +112,10 @@ def mitsuba_scene_text(text, width, height, samples):
     hide = '<boolean name="hide_emitters" value="true"/>' if hidden else ''
     direct = (f'<integrator type="direct"><integer name="emitter_samples" value="{samples}"/>'
               f'<integer name="bsdf_samples" value="{samples}"/>{hide}</integrator>')
-    text, count = re.subn(r"<integrator\b[^>]*/>|<integrator\b[^>]*[^/]>.*?</integrator>",
-                          direct, text, count=1, flags=re.S)
-    if count == 0:
+    span = outer_element(text, "integrator")
+    if span:
+        text = text[:span[0]] + direct + text[span[1]:]
+    else:
         text = re.sub(r"(<scene\b[^>]*>)", r"\1" + direct, text, count=1)
 
     def film(match):

@@ -233,6 +233,10 @@ fn every_error_names_file_line_and_problem() {
         ("<scene>\n<banana/></scene>", "test.xml:2: unexpected element <banana> in <scene>"),
         ("<scene>\n<shape/></scene>", "test.xml:2: <shape> needs a \"type\" attribute"),
         ("<scene>\n<shape type=\"teapot\"/></scene>", "test.xml:2: shape type \"teapot\" is not supported"),
+        ("<scene>\n<shape type=\"shapegroup\"><shape type=\"cube\"/></shape></scene>", "test.xml:2: a shapegroup needs an id"),
+        ("<scene><shape type=\"shapegroup\" id=\"g\">\n<shape type=\"cube\"><emitter type=\"area\"/></shape></shape></scene>", "test.xml:2: a shape in a shapegroup cannot emit"),
+        ("<scene>\n<shape type=\"instance\"><ref id=\"g\"/></shape><shape type=\"shapegroup\" id=\"g\"/></scene>", "test.xml:2: no shapegroup with id \"g\" (declare it before its instances)"),
+        ("<scene><shape type=\"shapegroup\" id=\"g\"/>\n<shape type=\"instance\"/></scene>", "test.xml:2: an instance references exactly one shapegroup"),
         ("<scene>\n<shape type=\"obj\"/></scene>", "needs a \"filename\" string"),
         ("<scene><shape type=\"sphere\">\n<float name=\"radius\" value=\"abc\"/></shape></scene>", "test.xml:2: \"abc\" is not a number"),
         ("<scene><shape type=\"sphere\">\n<float name=\"radius\" value=\"-1\"/></shape></scene>", "radius must be positive"),
@@ -655,5 +659,36 @@ fn a_missing_mesh_attribute_is_refused_with_those_there() {
     assert!(
         message.contains("attributes-test.xml:2: the shape has no mesh attribute \"vertex_colour\" (it has: vertex_color, face_weight)"),
         "{message}"
+    );
+}
+
+#[test]
+fn instances_copy_their_group_under_their_transform() {
+    let text = r#"<scene version="3.0.0">
+        <shape type="shapegroup" id="g">
+            <shape type="cube"><transform name="to_world"><translate x="1"/></transform></shape>
+            <shape type="sphere"/>
+        </shape>
+        <shape type="instance"><ref id="g"/><transform name="to_world"><scale value="2"/></transform></shape>
+        <shape type="instance"><ref id="g"/></shape></scene>"#;
+    let scene = parse(text).unwrap();
+    assert_eq!(
+        scene.shapes.len(),
+        4,
+        "two shapes per instance, none for the group"
+    );
+    let moved = scene.shapes[0].to_world.transform_point3(DVec3::ZERO);
+    assert_eq!(
+        moved,
+        DVec3::new(2.0, 0.0, 0.0),
+        "the instance's transform after the shape's"
+    );
+    assert!(
+        scene
+            .warnings
+            .iter()
+            .filter(|w| w.contains("instances are copied"))
+            .count()
+            == 1
     );
 }

@@ -163,8 +163,10 @@ pub struct SceneDescription {
     pub filter: ReconstructionFilter,
     /// The sampler's `sample_count` (samples per pixel).
     pub sample_count: u32,
-    /// Shapes.
+    /// Shapes (instances' copies included).
     pub shapes: Vec<ShapeDescription>,
+    /// Shape groups, which instances copy.
+    pub shape_groups: Vec<super::instancing::ShapeGroup>,
     /// BSDFs (top-level with ids, and those nested in shapes), carried for the shading code.
     pub bsdfs: Vec<Plugin>,
     /// Top-level textures, which BSDFs reference by id.
@@ -201,6 +203,7 @@ impl SceneDescription {
             filter: ReconstructionFilter::MITSUBA_DEFAULT,
             sample_count: 4,
             shapes: Vec::new(),
+            shape_groups: Vec::new(),
             bsdfs: Vec::new(),
             textures: Vec::new(),
             referable: Vec::new(),
@@ -301,6 +304,13 @@ fn read_top_level(
     match plugin.tag.as_str() {
         "bsdf" | "texture" | "film" | "sampler" => {}
         "sensor" => read_sensor(path, plugin, scene).map_err(at)?,
+        "shape" if plugin.kind == "shapegroup" => {
+            super::instancing::read_shape_group(path, files, plugin, scene).map_err(at)?
+        }
+        "shape" if plugin.kind == "instance" => {
+            let shapes = super::instancing::instance_shapes(path, plugin, scene).map_err(at)?;
+            scene.shapes.extend(shapes);
+        }
         "shape" => {
             let shape = read_shape(path, files, plugin, scene).map_err(at)?;
             scene.shapes.push(shape);
@@ -582,7 +592,7 @@ fn positive_filter_size(
     Ok(value as f32)
 }
 
-fn read_shape(
+pub(super) fn read_shape(
     path: &Path,
     files: &FileResolver,
     shape: &Plugin,

@@ -3,6 +3,7 @@
 mod cie1931;
 mod description;
 mod file_resolver;
+mod instancing;
 mod properties;
 mod spectrum;
 mod xml;
@@ -13,6 +14,7 @@ pub use description::{
 };
 pub(crate) use description::{read_fov, warn_unknown};
 pub use file_resolver::FileResolver;
+pub use instancing::ShapeGroup;
 pub use properties::{LocatedProperty, Plugin, Property};
 pub use spectrum::{ColourRole, SampledSpectrum, Spectrum};
 pub use xml::look_at;
