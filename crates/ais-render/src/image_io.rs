@@ -153,7 +153,7 @@ fn read_hdr(path: &Path) -> Result<RgbImage, InputError> {
     })
 }
 
-/// Reads a PNG or JPEG texture into linear RGB: sRGB-decoded when `srgb` (Mitsuba's
+/// Reads a PNG, JPEG, BMP, TGA or PPM/PGM texture into linear RGB: sRGB-decoded when `srgb` (Mitsuba's
 /// default for such images), else the stored values scaled to [0, 1]. At most 16384 texels
 /// a side; alpha is dropped.
 pub fn read_ldr_image(path: &Path, srgb: bool) -> Result<RgbImage, InputError> {
