@@ -423,19 +423,22 @@ fn texture_errors_name_file_line_and_problem() {
 }
 
 #[test]
-fn textures_reach_the_albedo_and_warn_where_they_do_not() {
+fn textures_reach_their_parameters_and_warn_where_they_do_not() {
     let text = r#"<scene>
         <texture type="checkerboard" id="checks"><rgb name="color0" value="0.9"/></texture>
         <bsdf type="diffuse" id="d"><ref name="reflectance" id="checks"/></bsdf>
         <bsdf type="roughconductor" id="c">
-            <texture type="checkerboard" name="specular_reflectance"/></bsdf>
+            <texture type="checkerboard" name="eta"/>
+            <texture type="checkerboard" name="alpha"/></bsdf>
         <shape type="rectangle"><ref id="d"/></shape>
         <shape type="rectangle"><ref id="c"/></shape>
         <shape type="sphere"><transform name="to_world"><rotate x="1" angle="30"/></transform><ref id="d"/></shape>
     </scene>"#;
     let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
     let albedo = |shape: usize| match world.surfaces[shape].as_ref() {
-        ais_render::bsdf::Surface::Material { albedo, .. } => albedo.clone(),
+        ais_render::bsdf::Surface::Material { textures, .. } => (textures.iter())
+            .find(|t| t.parameter == ais_render::bsdf::TexturedParameter::Albedo)
+            .map(|t| t.texture.clone()),
         other => panic!("{other:?}"),
     };
     let board = albedo(0).expect("the diffuse is textured");
@@ -444,9 +447,14 @@ fn textures_reach_the_albedo_and_warn_where_they_do_not() {
         glam::Vec3::splat(0.9)
     );
     assert!(albedo(1).is_none());
+    let ais_render::bsdf::Surface::Material { textures, .. } = world.surfaces[1].as_ref() else {
+        panic!("{:?}", world.surfaces[1]);
+    };
+    let parameters: Vec<_> = textures.iter().map(|t| t.parameter).collect();
+    assert_eq!(parameters, [ais_render::bsdf::TexturedParameter::Roughness]);
     let warned = |want: &str| world.warnings.iter().any(|w| w.contains(want));
     assert!(
-        warned("textures are not supported: specular_reflectance"),
+        warned("textures are not supported: eta"),
         "{:?}",
         world.warnings
     );

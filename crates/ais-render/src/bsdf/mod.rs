@@ -2,10 +2,10 @@
 //! sampling), the smooth `conductor`, `plastic`, `dielectric` and `thindielectric`, and the
 //! `twosided` adapter, each evaluating as Mitsuba 3 does.
 
-mod albedo;
 mod conductors;
 mod hit;
 mod microfacet;
+mod parameter_textures;
 mod reader;
 mod rough_dielectric;
 mod rough_plastic;
@@ -14,11 +14,13 @@ mod surface;
 mod surface_reader;
 mod tilted_normals;
 
-pub(crate) use albedo::parameter_texture;
-pub use albedo::{albedo_texture, TextureScene};
 pub use conductors::named_conductor;
 pub use hit::{HitBsdf, Mixture, MixturePart};
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
+pub(crate) use parameter_textures::parameter_texture;
+pub use parameter_textures::{
+    material_textures, ParameterTexture, TextureScene, TexturedParameter,
+};
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};

@@ -212,11 +212,12 @@ impl BsdfReader<'_> {
             let known = known_properties(&plugin.kind);
             crate::scene::warn_unknown(self.file, plugin, known, self.warnings);
         }
-        let albedo = super::albedo::albedo_parameter(&plugin.kind);
+        let textured = super::parameter_textures::textured_parameters(&plugin.kind);
+        let is_textured = |name: Option<&str>| textured.iter().any(|(n, _)| Some(*n) == name);
         for child in plugin
             .children
             .iter()
-            .filter(|c| c.tag == "texture" && c.name.as_deref() != albedo)
+            .filter(|c| c.tag == "texture" && !is_textured(c.name.as_deref()))
         {
             self.warnings.push(format!(
                 "{}:{}: textures are not supported: {} \"{}\" keeps its default",

@@ -92,6 +92,15 @@ impl RoughPlastic {
         }
     }
 
+    /// The same plastic with coating tint `specular` (the interface terms are shared).
+    pub fn with_specular(&self, specular: Vec3) -> Self {
+        RoughPlastic {
+            specular,
+            specular_weight: specular_weight(self.diffuse, specular),
+            ..self.clone()
+        }
+    }
+
     /// T(μ), interpolated linearly in the table.
     fn transmittance(&self, mu: f32) -> f32 {
         let x = mu.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;

@@ -171,6 +171,11 @@ impl SmoothPlastic {
         SmoothPlastic::new(self.eta, diffuse, self.specular, self.nonlinear)
     }
 
+    /// The same plastic with coating tint `specular`.
+    pub fn with_specular(&self, specular: Vec3) -> Self {
+        SmoothPlastic::new(self.eta, self.diffuse, specular, self.nonlinear)
+    }
+
     /// The probability that a sample seen from `o` picks the mirror lobe: its reflectance
     /// F(θo) weighed against the base's share, as Mitsuba's sampler does.
     fn mirror_probability(&self, o: Vec3) -> f32 {

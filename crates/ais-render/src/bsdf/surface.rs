@@ -1,11 +1,11 @@
-//! What a shape's `<bsdf>` gives at each point of the shape: a material whose albedo may
-//! come from a texture, Mitsuba's `mask` (an opacity over a material) and `blendbsdf` (two
+//! What a shape's `<bsdf>` gives at each point of the shape: a material whose parameters
+//! may come from textures, Mitsuba's `mask` (an opacity over a material) and `blendbsdf` (two
 //! materials mixed by a weight), each of which may vary over the surface, and `null`.
 //! [`Surface::at`] resolves it at a hit into the [`HitBsdf`] the gather evaluates.
 
 use super::hit::{HitBsdf, Mixture, MixturePart};
 use super::tilted_normals::{bump_map_normal, normal_map_normal, tilted_frame};
-use super::{Material, NormalMapOptions, ShadingFrame};
+use super::{Material, NormalMapOptions, ParameterTexture, ShadingFrame, TexturedParameter};
 use crate::mesh::AttributeSite;
 use crate::texture::{Texture, TextureLookup};
 use glam::{Vec2, Vec3};
@@ -15,12 +15,12 @@ use std::sync::Arc;
 /// A shape's scattering over its surface.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Surface {
-    /// One material; its albedo is the texture's value at the hit when it has one.
+    /// One material; textured parameters take their textures' values at the hit.
     Material {
-        /// The material (with the constant albedo a texture replaces).
+        /// The material (with the constants that textures replace).
         material: Material,
-        /// The texture that gives the albedo, if one does.
-        albedo: Option<Arc<Texture>>,
+        /// The textures on its parameters.
+        textures: Vec<ParameterTexture>,
     },
     /// Mitsuba's `mask`: the material where the surface is opaque; light passes straight
     /// through elsewhere.
@@ -134,7 +134,7 @@ impl From<Material> for Surface {
     fn from(material: Material) -> Self {
         Surface::Material {
             material,
-            albedo: None,
+            textures: Vec::new(),
         }
     }
 }
@@ -167,7 +167,9 @@ impl Surface {
             Fraction::Constant(_) => Vec::new(),
         };
         match self {
-            Surface::Material { albedo, .. } => albedo.as_deref().map_or(Vec::new(), texture_names),
+            Surface::Material { textures, .. } => (textures.iter())
+                .flat_map(|t| texture_names(&t.texture))
+                .collect(),
             Surface::Mask { opacity, inner } => {
                 [fraction_names(opacity), inner.attribute_names()].concat()
             }
@@ -195,7 +197,7 @@ impl Surface {
     /// Whether anything varies over the surface by texture coordinates.
     pub fn is_textured(&self) -> bool {
         match self {
-            Surface::Material { albedo, .. } => albedo.is_some(),
+            Surface::Material { textures, .. } => !textures.is_empty(),
             Surface::Mask { opacity, inner } => opacity.is_textured() || inner.is_textured(),
             Surface::Tilted { .. } => true,
             Surface::Blend {
@@ -221,10 +223,11 @@ impl Surface {
     /// The BSDF at `point`, and the frame that stands for the surface there (for what
     /// keys on the normal, and for offsetting rays).
     pub fn at(&self, point: &SurfacePoint) -> (HitBsdf<'_>, ShadingFrame) {
-        if let Surface::Material { material, albedo } = self {
-            let material = match albedo {
-                Some(texture) => Cow::Owned(material.with_albedo(texture.eval_at(&point.lookup()))),
-                None => Cow::Borrowed(material),
+        if let Surface::Material { material, textures } = self {
+            let material = if textures.is_empty() {
+                Cow::Borrowed(material)
+            } else {
+                Cow::Owned(textured(material, textures, point))
             };
             let frame = point.frame(material.two_sided);
             return (HitBsdf::Single { material, frame }, frame);
@@ -238,11 +241,8 @@ impl Surface {
     /// Adds this surface's materials, and what passes through, with `share` of the total.
     fn add_parts(&self, point: &SurfacePoint, share: f32, mixture: &mut Mixture) {
         match self {
-            Surface::Material { material, albedo } => {
-                let material = match albedo {
-                    Some(texture) => material.with_albedo(texture.eval_at(&point.lookup())),
-                    None => material.clone(),
-                };
+            Surface::Material { material, textures } => {
+                let material = textured(material, textures, point);
                 let frame = point.frame(material.two_sided);
                 mixture.parts.push(MixturePart {
                     weight: share,
@@ -282,6 +282,21 @@ impl Surface {
             Surface::Null => mixture.pass_through += share,
         }
     }
+}
+
+/// `material` with its textured parameters set to their textures' values at `point` (the
+/// roughness read as one channel, as Mitsuba reads it).
+fn textured(material: &Material, textures: &[ParameterTexture], point: &SurfacePoint) -> Material {
+    let mut material = material.clone();
+    let lookup = point.lookup();
+    for ParameterTexture { parameter, texture } in textures {
+        let value = match parameter {
+            TexturedParameter::Roughness => Vec3::splat(texture.eval_scalar_at(&lookup)),
+            _ => texture.eval_at(&lookup),
+        };
+        material.set_parameter(*parameter, value);
+    }
+    material
 }
 
 impl SurfacePoint<'_> {

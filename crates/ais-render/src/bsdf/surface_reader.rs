@@ -1,8 +1,8 @@
 //! Reading a shape's `<bsdf>` into a [`Surface`]: `mask`, `blendbsdf`, `null` and
 //! `twosided` around them read here; every other type is one material
-//! ([`Material::from_plugin`]) with its albedo texture.
+//! ([`Material::from_plugin`]) with the textures on its parameters.
 
-use super::albedo::{albedo_texture, parameter_texture, TextureScene};
+use super::parameter_textures::{material_textures, parameter_texture, TextureScene};
 use super::surface::{Fraction, Surface, TiltedNormals};
 use super::{Material, NormalMapOptions};
 use crate::error::InputError;
@@ -94,15 +94,12 @@ impl<'a> SurfaceReader<'a, '_> {
         }
     }
 
-    /// One material, its albedo from a texture if one gives it.
+    /// One material, with the textures on its parameters.
     fn material(&mut self, plugin: &Plugin) -> Result<Surface, InputError> {
         let scene = self.scene;
         let material = Material::from_plugin(plugin, scene.file, scene.bsdfs, self.warnings)?;
-        let albedo = albedo_texture(plugin, scene, self.warnings)?;
-        Ok(Surface::Material {
-            material,
-            albedo: albedo.map(Arc::new),
-        })
+        let textures = material_textures(plugin, scene, self.warnings)?;
+        Ok(Surface::Material { material, textures })
     }
 
     /// The BSDFs nested in `plugin` or named by its references, in the file's order.

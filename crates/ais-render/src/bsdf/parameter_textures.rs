@@ -1,0 +1,181 @@
+//! Textures on a BSDF's parameters, as Mitsuba accepts them: the albedo (`reflectance` of
+//! `diffuse`, `diffuse_reflectance` of the plastics), `specular_reflectance` (conductors,
+//! plastics, dielectrics), `specular_transmittance` (dielectrics) and the roughness `alpha`
+//! (`roughconductor`, `roughdielectric`), also inside `twosided`, as a nested `<texture>` or
+//! a `<ref>` to a top-level one. The material read by [`super::Material::from_plugin`] keeps
+//! the constant default; [`super::Material::set_parameter`] puts a texture's value at a hit
+//! in its place.
+
+use super::{Material, Scattering};
+use crate::error::InputError;
+use crate::scene::{FileResolver, Plugin};
+use crate::texture::{read_texture, Texture};
+use glam::Vec3;
+use std::path::Path;
+use std::sync::Arc;
+
+/// What reading a texture needs from its scene.
+pub struct TextureScene<'a> {
+    /// The scene file, for errors and warnings.
+    pub file: &'a Path,
+    /// Where image file names point.
+    pub files: &'a FileResolver,
+    /// The scene's BSDFs, which a `twosided`'s reference names.
+    pub bsdfs: &'a [Plugin],
+    /// The scene's top-level textures, which references name.
+    pub textures: &'a [Plugin],
+}
+
+/// A material parameter that a texture may give.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TexturedParameter {
+    /// The diffuse albedo (colour).
+    Albedo,
+    /// The specular reflectance (colour).
+    SpecularReflectance,
+    /// The specular transmittance (colour).
+    SpecularTransmittance,
+    /// The microfacet roughness α (one channel).
+    Roughness,
+}
+
+/// A texture on one parameter.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParameterTexture {
+    /// The parameter.
+    pub parameter: TexturedParameter,
+    /// Its texture.
+    pub texture: Arc<Texture>,
+}
+
+/// The parameters of a BSDF type that textures may give, by property name.
+pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, TexturedParameter)] {
+    use TexturedParameter::*;
+    match kind {
+        "diffuse" => &[("reflectance", Albedo)],
+        "roughplastic" | "plastic" => &[
+            ("diffuse_reflectance", Albedo),
+            ("specular_reflectance", SpecularReflectance),
+        ],
+        "conductor" => &[("specular_reflectance", SpecularReflectance)],
+        "roughconductor" => &[
+            ("specular_reflectance", SpecularReflectance),
+            ("alpha", Roughness),
+        ],
+        "dielectric" | "thindielectric" => &[
+            ("specular_reflectance", SpecularReflectance),
+            ("specular_transmittance", SpecularTransmittance),
+        ],
+        "roughdielectric" => &[
+            ("specular_reflectance", SpecularReflectance),
+            ("specular_transmittance", SpecularTransmittance),
+            ("alpha", Roughness),
+        ],
+        _ => &[],
+    }
+}
+
+/// The textures on the parameters of the BSDF `plugin` (through `twosided`).
+pub fn material_textures(
+    plugin: &Plugin,
+    scene: &TextureScene,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<ParameterTexture>, InputError> {
+    let mut current = plugin;
+    // A twosided wraps one BSDF (nesting depth is checked when the material is read).
+    for _ in 0..16 {
+        if current.kind != "twosided" {
+            break;
+        }
+        let nested = current.children.iter().find(|c| c.tag == "bsdf");
+        let referenced = current.references.first().and_then(|(_, id, _)| {
+            scene
+                .bsdfs
+                .iter()
+                .find(|b| b.id.as_deref() == Some(id.as_str()))
+        });
+        match nested.or(referenced) {
+            Some(inner) => current = inner,
+            None => return Ok(Vec::new()),
+        }
+    }
+    let mut textures = Vec::new();
+    for &(name, parameter) in textured_parameters(&current.kind) {
+        if let Some(texture) = parameter_texture(current, name, scene, warnings)? {
+            textures.push(ParameterTexture {
+                parameter,
+                texture: Arc::new(texture),
+            });
+        }
+    }
+    Ok(textures)
+}
+
+/// The texture that gives `parameter` of `plugin`: a nested `<texture>` of that name, or a
+/// `<ref>` of that name to a top-level one.
+pub(crate) fn parameter_texture(
+    plugin: &Plugin,
+    parameter: &str,
+    scene: &TextureScene,
+    warnings: &mut Vec<String>,
+) -> Result<Option<Texture>, InputError> {
+    if let Some(child) = plugin
+        .children
+        .iter()
+        .find(|c| c.tag == "texture" && c.name.as_deref() == Some(parameter))
+    {
+        return read_texture(scene.file, scene.files, child, warnings).map(Some);
+    }
+    let Some((_, id, line)) = plugin
+        .references
+        .iter()
+        .find(|(name, _, _)| name.as_deref() == Some(parameter))
+    else {
+        return Ok(None);
+    };
+    let texture = scene
+        .textures
+        .iter()
+        .find(|t| t.id.as_deref() == Some(id.as_str()))
+        .ok_or_else(|| {
+            InputError::at(scene.file, *line, format!("no <texture> with id \"{id}\""))
+        })?;
+    read_texture(scene.file, scene.files, texture, warnings).map(Some)
+}
+
+impl Material {
+    /// Sets `parameter` to `value` (a colour, or for the roughness its first component), as
+    /// a texture gives it at a hit. A parameter the material does not have is left alone.
+    pub fn set_parameter(&mut self, parameter: TexturedParameter, value: Vec3) {
+        use TexturedParameter::*;
+        let colour = value.max(Vec3::ZERO);
+        let albedo = colour.min(Vec3::ONE);
+        match (&mut self.scattering, parameter) {
+            (Scattering::Diffuse { reflectance }, Albedo) => *reflectance = albedo,
+            (Scattering::RoughPlastic(plastic), Albedo) => *plastic = plastic.with_diffuse(albedo),
+            (Scattering::Plastic(plastic), Albedo) => *plastic = plastic.with_diffuse(albedo),
+            (Scattering::RoughPlastic(plastic), SpecularReflectance) => {
+                *plastic = plastic.with_specular(colour)
+            }
+            (Scattering::Plastic(plastic), SpecularReflectance) => {
+                *plastic = plastic.with_specular(colour)
+            }
+            (
+                Scattering::RoughConductor { specular, .. }
+                | Scattering::Conductor { specular, .. },
+                SpecularReflectance,
+            ) => *specular = colour,
+            (Scattering::Dielectric(d), SpecularReflectance) => d.reflectance = colour,
+            (Scattering::Dielectric(d), SpecularTransmittance) => d.transmittance = colour,
+            (Scattering::RoughDielectric(d), SpecularReflectance) => d.reflectance = colour,
+            (Scattering::RoughDielectric(d), SpecularTransmittance) => d.transmittance = colour,
+            (Scattering::RoughConductor { microfacet, .. }, Roughness) => {
+                *microfacet = super::Microfacet::new(microfacet.kind, value.x)
+            }
+            (Scattering::RoughDielectric(d), Roughness) => {
+                d.microfacet = super::Microfacet::new(d.microfacet.kind, value.x)
+            }
+            _ => {}
+        }
+    }
+}
