@@ -8,8 +8,8 @@ use ais::mapping::LatLong;
 use ais::rng::Pcg32;
 use ais::testing::{ChiSquareTest, Drawn};
 use ais_render::bsdf::{
-    Dielectric, Fraction, Material, Microfacet, RoughDielectric, RoughPlastic, Scattering,
-    ShadingFrame, SmoothPlastic, Surface, SurfacePoint,
+    Dielectric, Fraction, Material, Microfacet, MicrofacetKind, RoughDielectric, RoughPlastic,
+    Scattering, ShadingFrame, SmoothPlastic, Surface, SurfacePoint,
 };
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
@@ -477,6 +477,8 @@ fn conductor_sampling_fits_for_both_distributions() {
         Microfacet::ggx(0.6),
         Microfacet::beckmann(0.15),
         Microfacet::beckmann(0.6),
+        Microfacet::anisotropic(MicrofacetKind::Ggx, 0.1, 0.5),
+        Microfacet::anisotropic(MicrofacetKind::Beckmann, 0.5, 0.15),
     ] {
         let label = format!("{microfacet:?}");
         assert_sampling_fits(&conductor(microfacet), 20, &views(), &label);
@@ -578,7 +580,11 @@ fn rough_glass(microfacet: Microfacet) -> Material {
 fn rough_dielectric_sampling_fits_from_both_sides() {
     // Samples refused (total internal reflection, microfacets facing away) are missing
     // mass, which the density accounts for.
-    for microfacet in [Microfacet::ggx(0.3), Microfacet::beckmann(0.5)] {
+    for microfacet in [
+        Microfacet::ggx(0.3),
+        Microfacet::beckmann(0.5),
+        Microfacet::anisotropic(MicrofacetKind::Ggx, 0.15, 0.45),
+    ] {
         // Each view, and its mirror image through the surface (seen from inside).
         let both_sides: Vec<(ShadingFrame, Vec3)> = views()
             .into_iter()
@@ -644,6 +650,8 @@ fn microfacet_bsdfs_do_not_create_energy() {
     for material in [
         conductor(Microfacet::ggx(0.5)),
         conductor(Microfacet::beckmann(0.5)),
+        conductor(Microfacet::anisotropic(MicrofacetKind::Ggx, 0.1, 0.6)),
+        conductor(Microfacet::anisotropic(MicrofacetKind::Beckmann, 0.6, 0.1)),
         plastic(0.3, Vec3::ONE),
         // Seen from outside: reflection plus transmission (radiance scaled by 1/η²).
         rough_glass(Microfacet::ggx(0.3)),

@@ -1,5 +1,6 @@
-//! Isotropic microfacet distributions, Beckmann and GGX (Trowbridge-Reitz), with Smith
-//! masking, in a local frame where the normal is +z. As in Mitsuba 3: `alpha` is the
+//! Microfacet distributions, Beckmann and GGX (Trowbridge-Reitz), isotropic or anisotropic,
+//! with Smith masking, in a local frame where the normal is +z and +x the tangent (∂p/∂u).
+//! As in Mitsuba 3: `alpha` (or `alpha_u` along the tangent and `alpha_v` across it) is the
 //! distribution's width, Beckmann is the default when a scene names none, Beckmann's
 //! masking uses Walter et al.'s rational approximation of Smith's G1, and shadowing-masking
 //! is the separable product G1(wi) G1(wo). GGX is sampled by its visible normals (Heitz
@@ -18,22 +19,35 @@ pub enum MicrofacetKind {
     Ggx,
 }
 
-/// A microfacet distribution of roughness `alpha`.
+/// A microfacet distribution of roughness `alpha_u` along the tangent and `alpha_v` across.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Microfacet {
     /// The distribution's shape.
     pub kind: MicrofacetKind,
-    /// Roughness, clamped to [1e-4, 1].
-    pub alpha: f32,
+    /// Roughness along the shading frame's tangent (∂p/∂u), clamped to [1e-4, 1].
+    pub alpha_u: f32,
+    /// Roughness along the bitangent; equal to `alpha_u` for an isotropic surface.
+    pub alpha_v: f32,
 }
 
 impl Microfacet {
     /// A distribution of roughness `alpha`.
     pub fn new(kind: MicrofacetKind, alpha: f32) -> Self {
+        Microfacet::anisotropic(kind, alpha, alpha)
+    }
+
+    /// A distribution of roughness `alpha_u` along the tangent and `alpha_v` across it.
+    pub fn anisotropic(kind: MicrofacetKind, alpha_u: f32, alpha_v: f32) -> Self {
         Microfacet {
             kind,
-            alpha: alpha.clamp(1e-4, 1.0),
+            alpha_u: alpha_u.clamp(1e-4, 1.0),
+            alpha_v: alpha_v.clamp(1e-4, 1.0),
         }
+    }
+
+    /// Whether the roughness differs along the tangent and across it.
+    pub fn is_anisotropic(&self) -> bool {
+        self.alpha_u != self.alpha_v
     }
 
     /// GGX of roughness `alpha`.
@@ -51,7 +65,10 @@ impl Microfacet {
         if h.z <= 0.0 {
             return 0.0;
         }
-        let a2 = self.alpha * self.alpha;
+        if self.is_anisotropic() {
+            return self.anisotropic_d(h);
+        }
+        let a2 = self.alpha_u * self.alpha_u;
         let cos2 = h.z * h.z;
         match self.kind {
             MicrofacetKind::Ggx => {
@@ -68,6 +85,19 @@ impl Microfacet {
         }
     }
 
+    /// [`Microfacet::d`] with different roughness along and across the tangent.
+    fn anisotropic_d(&self, h: Vec3) -> f32 {
+        let (au, av) = (self.alpha_u, self.alpha_v);
+        let cos2 = h.z * h.z;
+        // tan²θ (cos²φ / α_u² + sin²φ / α_v²)
+        let e = (h.x * h.x / (au * au) + h.y * h.y / (av * av)) / cos2;
+        let scale = PI * au * av * cos2 * cos2;
+        match self.kind {
+            MicrofacetKind::Ggx => 1.0 / (scale * (1.0 + e) * (1.0 + e)),
+            MicrofacetKind::Beckmann => (-e).exp() / scale,
+        }
+    }
+
     /// Smith's masking of direction `w` (either side of the surface) by microfacet `m`:
     /// zero when `w` sees the back of `m`.
     pub fn g1(&self, w: Vec3, m: Vec3) -> f32 {
@@ -78,7 +108,13 @@ impl Microfacet {
         if xy2 == 0.0 {
             return 1.0;
         }
-        let tan2_alpha2 = self.alpha * self.alpha * xy2 / (w.z * w.z);
+        // tan²θ times the roughness projected on the direction's azimuth.
+        let tan2_alpha2 = if self.is_anisotropic() {
+            let (au, av) = (self.alpha_u, self.alpha_v);
+            (au * au * w.x * w.x + av * av * w.y * w.y) / (w.z * w.z)
+        } else {
+            self.alpha_u * self.alpha_u * xy2 / (w.z * w.z)
+        };
         match self.kind {
             MicrofacetKind::Ggx => 2.0 / (1.0 + (1.0 + tan2_alpha2).sqrt()),
             MicrofacetKind::Beckmann => {
@@ -102,8 +138,18 @@ impl Microfacet {
     pub fn sample(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
         match self.kind {
             MicrofacetKind::Ggx => self.sample_visible_ggx(wo, u),
+            MicrofacetKind::Beckmann if self.is_anisotropic() => {
+                // Slopes of the unit distribution, stretched by the roughness.
+                let radius = (-(1.0 - u[0]).max(1e-30).ln()).sqrt();
+                let phi = 2.0 * PI * u[1];
+                let slope = (
+                    self.alpha_u * radius * phi.cos(),
+                    self.alpha_v * radius * phi.sin(),
+                );
+                Vec3::new(-slope.0, -slope.1, 1.0).normalize()
+            }
             MicrofacetKind::Beckmann => {
-                let tan2 = -self.alpha * self.alpha * (1.0 - u[0]).max(1e-30).ln();
+                let tan2 = -self.alpha_u * self.alpha_u * (1.0 - u[0]).max(1e-30).ln();
                 let cos = 1.0 / (1.0 + tan2).sqrt();
                 let sin = (1.0 - cos * cos).max(0.0).sqrt();
                 let phi = 2.0 * PI * u[1];
@@ -127,7 +173,7 @@ impl Microfacet {
 
     fn sample_visible_ggx(&self, wo: Vec3, u: [f32; 2]) -> Vec3 {
         // Stretch the view so that the distribution becomes the unit hemisphere.
-        let v = Vec3::new(self.alpha * wo.x, self.alpha * wo.y, wo.z).normalize();
+        let v = Vec3::new(self.alpha_u * wo.x, self.alpha_v * wo.y, wo.z).normalize();
         let length2 = v.x * v.x + v.y * v.y;
         let t1 = if length2 > 0.0 {
             Vec3::new(-v.y, v.x, 0.0) / length2.sqrt()
@@ -141,7 +187,7 @@ impl Microfacet {
         let s = 0.5 * (1.0 + v.z);
         let p2 = (1.0 - s) * (1.0 - p1 * p1).max(0.0).sqrt() + s * r * phi.sin();
         let n = t1 * p1 + t2 * p2 + v * (1.0 - p1 * p1 - p2 * p2).max(0.0).sqrt();
-        Vec3::new(self.alpha * n.x, self.alpha * n.y, n.z.max(1e-6)).normalize()
+        Vec3::new(self.alpha_u * n.x, self.alpha_v * n.y, n.z.max(1e-6)).normalize()
     }
 }
 
@@ -200,6 +246,26 @@ mod tests {
                 sum += distribution.d(h) * cos * 2.0 * PI / n as f32;
             }
             assert!((sum - 1.0).abs() < 0.01, "{distribution:?}: {sum}");
+        }
+    }
+
+    #[test]
+    fn anisotropic_normals_integrate_to_one_over_projected_area() {
+        for kind in [MicrofacetKind::Ggx, MicrofacetKind::Beckmann] {
+            let distribution = Microfacet::anisotropic(kind, 0.15, 0.5);
+            let (rows, columns) = (2000, 256);
+            let mut sum = 0.0f64;
+            for i in 0..rows {
+                let cos = (i as f32 + 0.5) / rows as f32;
+                let sin = (1.0 - cos * cos).sqrt();
+                for j in 0..columns {
+                    let phi = 2.0 * PI * (j as f32 + 0.5) / columns as f32;
+                    let h = Vec3::new(sin * phi.cos(), sin * phi.sin(), cos);
+                    let cell = (1.0 / rows as f32) * (2.0 * PI / columns as f32);
+                    sum += (distribution.d(h) * cos * cell) as f64;
+                }
+            }
+            assert!((sum - 1.0).abs() < 0.01, "{kind:?}: {sum}");
         }
     }
 

@@ -151,6 +151,43 @@ impl ShadingFrame {
         }
     }
 
+    /// [`ShadingFrame::oriented`] with its tangent along `dp_du` (made perpendicular to the
+    /// shading normal), as an anisotropic material needs: Mitsuba's shading frame. Seen from
+    /// behind a two-sided material, the normal turns and the tangents stay (the directions
+    /// are mirrored through the surface, as Mitsuba's `twosided` mirrors them).
+    pub fn along_tangent(
+        shading_normal: Vec3,
+        geometric_normal: Vec3,
+        wo: Vec3,
+        two_sided: bool,
+        dp_du: Vec3,
+    ) -> Self {
+        let projected = dp_du - shading_normal * shading_normal.dot(dp_du);
+        let tangent = projected
+            .try_normalize()
+            .unwrap_or_else(|| basis(shading_normal).0);
+        let bitangent = shading_normal.cross(tangent);
+        let flip = two_sided && geometric_normal.dot(wo) < 0.0;
+        let sign = if flip { -1.0 } else { 1.0 };
+        ShadingFrame {
+            normal: shading_normal * sign,
+            geometric: geometric_normal * sign,
+            tangent,
+            bitangent,
+        }
+    }
+
+    /// A frame of unit, orthogonal `tangent`, `bitangent` and `normal`, with `geometric` on
+    /// the normal's side.
+    pub fn from_axes(normal: Vec3, geometric: Vec3, tangent: Vec3, bitangent: Vec3) -> Self {
+        ShadingFrame {
+            normal,
+            geometric,
+            tangent,
+            bitangent,
+        }
+    }
+
     /// A frame around `normal` (unit), with `geometric` on its side.
     pub fn with_normal(normal: Vec3, geometric: Vec3) -> Self {
         let (tangent, bitangent) = basis(normal);
@@ -178,6 +215,16 @@ impl ShadingFrame {
 }
 
 impl Material {
+    /// Whether its roughness differs along and across the tangent (it then needs the
+    /// frame of [`ShadingFrame::along_tangent`]).
+    pub fn is_anisotropic(&self) -> bool {
+        match &self.scattering {
+            Scattering::RoughConductor { microfacet, .. } => microfacet.is_anisotropic(),
+            Scattering::RoughDielectric(rough) => rough.microfacet.is_anisotropic(),
+            _ => false,
+        }
+    }
+
     /// One-sided diffuse of albedo `reflectance`.
     pub fn diffuse(reflectance: Vec3) -> Self {
         Material {
@@ -412,7 +459,7 @@ mod tests {
     fn unsupported_bsdfs_and_properties_warn() {
         let (m, warnings) = materials(
             r#"<bsdf type="measured" id="a"/>
-               <bsdf type="roughconductor" id="b"><string name="material" value="Unobtainium"/><float name="alpha_u" value="0.1"/></bsdf>
+               <bsdf type="roughconductor" id="b"><string name="material" value="Unobtainium"/><float name="sheen" value="0.1"/></bsdf>
                <bsdf type="roughplastic" id="c"><string name="int_ior" value="kryptonite"/></bsdf>"#,
         );
         assert_eq!(m[0], Material::default());
@@ -422,7 +469,7 @@ mod tests {
             "{all}"
         );
         assert!(
-            all.contains("Unobtainium") && all.contains("alpha_u") && all.contains("kryptonite"),
+            all.contains("Unobtainium") && all.contains("sheen") && all.contains("kryptonite"),
             "{all}"
         );
     }

@@ -37,6 +37,17 @@ pub enum TexturedParameter {
     SpecularTransmittance,
     /// The microfacet roughness α (one channel).
     Roughness,
+    /// The roughness along the tangent, α_u (one channel).
+    RoughnessU,
+    /// The roughness across the tangent, α_v (one channel).
+    RoughnessV,
+}
+
+impl TexturedParameter {
+    /// Whether a texture gives it as one channel (a roughness) rather than a colour.
+    pub fn is_scalar(self) -> bool {
+        matches!(self, Self::Roughness | Self::RoughnessU | Self::RoughnessV)
+    }
 }
 
 /// A texture on one parameter.
@@ -61,6 +72,8 @@ pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, Textur
         "roughconductor" => &[
             ("specular_reflectance", SpecularReflectance),
             ("alpha", Roughness),
+            ("alpha_u", RoughnessU),
+            ("alpha_v", RoughnessV),
         ],
         "dielectric" | "thindielectric" => &[
             ("specular_reflectance", SpecularReflectance),
@@ -70,6 +83,8 @@ pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, Textur
             ("specular_reflectance", SpecularReflectance),
             ("specular_transmittance", SpecularTransmittance),
             ("alpha", Roughness),
+            ("alpha_u", RoughnessU),
+            ("alpha_v", RoughnessV),
         ],
         _ => &[],
     }
@@ -169,13 +184,28 @@ impl Material {
             (Scattering::Dielectric(d), SpecularTransmittance) => d.transmittance = colour,
             (Scattering::RoughDielectric(d), SpecularReflectance) => d.reflectance = colour,
             (Scattering::RoughDielectric(d), SpecularTransmittance) => d.transmittance = colour,
-            (Scattering::RoughConductor { microfacet, .. }, Roughness) => {
-                *microfacet = super::Microfacet::new(microfacet.kind, value.x)
-            }
-            (Scattering::RoughDielectric(d), Roughness) => {
-                d.microfacet = super::Microfacet::new(d.microfacet.kind, value.x)
+            (
+                Scattering::RoughConductor { microfacet, .. },
+                Roughness | RoughnessU | RoughnessV,
+            ) => *microfacet = with_roughness(*microfacet, parameter, value.x),
+            (Scattering::RoughDielectric(d), Roughness | RoughnessU | RoughnessV) => {
+                d.microfacet = with_roughness(d.microfacet, parameter, value.x)
             }
             _ => {}
         }
     }
+}
+
+/// `microfacet` with the roughness `parameter` (both, or one axis) set to `alpha`.
+fn with_roughness(
+    microfacet: super::Microfacet,
+    parameter: TexturedParameter,
+    alpha: f32,
+) -> super::Microfacet {
+    let (u, v) = match parameter {
+        TexturedParameter::RoughnessU => (alpha, microfacet.alpha_v),
+        TexturedParameter::RoughnessV => (microfacet.alpha_u, alpha),
+        _ => (alpha, alpha),
+    };
+    super::Microfacet::anisotropic(microfacet.kind, u, v)
 }

@@ -286,12 +286,11 @@ impl BsdfReader<'_> {
         }
     }
 
-    /// The microfacet distribution: Beckmann unless GGX is named (Mitsuba's default).
-    fn microfacet(&mut self) -> Microfacet {
+    /// The microfacet distribution: Beckmann unless GGX is named (Mitsuba's default), of
+    /// roughness `alpha` (default 0.1), or `alpha_u` and `alpha_v` (both, without `alpha`)
+    /// for an anisotropic one where `anisotropic_allowed` (rough plastics are isotropic).
+    fn microfacet(&mut self, anisotropic_allowed: bool) -> Microfacet {
         let plugin = self.plugin;
-        if plugin.properties.contains_key("alpha_u") || plugin.properties.contains_key("alpha_v") {
-            self.warn("anisotropic alpha_u/alpha_v are not supported; using alpha".into());
-        }
         let kind = match plugin.string("distribution") {
             Ok(None) => MicrofacetKind::Beckmann,
             Ok(Some(d)) if d.eq_ignore_ascii_case("beckmann") => MicrofacetKind::Beckmann,
@@ -307,19 +306,37 @@ impl BsdfReader<'_> {
                 MicrofacetKind::Beckmann
             }
         };
-        let alpha = match plugin.float("alpha", 0.1) {
-            Ok(alpha) if alpha.is_finite() && alpha >= 0.0 => alpha,
+        let has = |name: &str| plugin.properties.contains_key(name);
+        let anisotropic = has("alpha_u")
+            || has("alpha_v")
+            || plugin
+                .children
+                .iter()
+                .any(|c| matches!(c.name.as_deref(), Some("alpha_u" | "alpha_v")));
+        if !(anisotropic && anisotropic_allowed) {
+            return Microfacet::new(kind, self.roughness("alpha"));
+        }
+        if has("alpha") {
+            self.warn("alpha_u/alpha_v are given: \"alpha\" is ignored".into());
+        }
+        let (alpha_u, alpha_v) = (self.roughness("alpha_u"), self.roughness("alpha_v"));
+        Microfacet::anisotropic(kind, alpha_u, alpha_v)
+    }
+
+    /// A roughness property (default 0.1, as in Mitsuba): a number ≥ 0, else 0.1 with a
+    /// warning. As in Mitsuba, roughness is at least 1e-4 (and at most 1 here).
+    fn roughness(&mut self, name: &str) -> f32 {
+        match self.plugin.float(name, 0.1) {
+            Ok(alpha) if alpha.is_finite() && alpha >= 0.0 => alpha as f32,
             Ok(alpha) => {
-                self.warn(format!("alpha = {alpha} must be a number ≥ 0; using 0.1"));
+                self.warn(format!("{name} = {alpha} must be a number ≥ 0; using 0.1"));
                 0.1
             }
             Err((_, message)) => {
-                self.warn(format!("{message}; using alpha = 0.1"));
+                self.warn(format!("{message}; using {name} = 0.1"));
                 0.1
             }
-        };
-        // As in Mitsuba, roughness is at least 1e-4 (and at most 1 here).
-        Microfacet::new(kind, alpha as f32)
+        }
     }
 
     /// A conductor's complex index of refraction: `eta` and `k`, or a named `material`.
@@ -342,7 +359,7 @@ impl BsdfReader<'_> {
     }
 
     fn rough_conductor(&mut self) -> Material {
-        let microfacet = self.microfacet();
+        let microfacet = self.microfacet(true);
         let (eta, k) = self.conductor_ior();
         let specular = self.colour("specular_reflectance", Vec3::ONE);
         Material {
@@ -357,7 +374,7 @@ impl BsdfReader<'_> {
     }
 
     fn rough_plastic(&mut self) -> Material {
-        let microfacet = self.microfacet();
+        let microfacet = self.microfacet(false);
         let coat = self.coating();
         Material {
             scattering: Scattering::RoughPlastic(RoughPlastic::new(
@@ -423,7 +440,7 @@ impl BsdfReader<'_> {
 
     /// `roughdielectric` (Mitsuba's default interior: BK7 glass), seen from either side.
     fn rough_dielectric(&mut self) -> Material {
-        let microfacet = self.microfacet();
+        let microfacet = self.microfacet(true);
         let eta = self.relative_ior(1.5046);
         Material {
             scattering: Scattering::RoughDielectric(RoughDielectric {

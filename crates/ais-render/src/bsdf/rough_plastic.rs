@@ -167,7 +167,7 @@ impl Interface {
         type Key = (MicrofacetKind, u32, u32);
         static CACHE: OnceLock<Mutex<HashMap<Key, Arc<Interface>>>> = OnceLock::new();
         let cache = CACHE.get_or_init(Default::default);
-        let key = (microfacet.kind, microfacet.alpha.to_bits(), eta.to_bits());
+        let key = (microfacet.kind, microfacet.alpha_u.to_bits(), eta.to_bits());
         if let Some(found) = cache.lock().unwrap_or_else(|e| e.into_inner()).get(&key) {
             return found.clone();
         }

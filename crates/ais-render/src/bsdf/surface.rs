@@ -5,7 +5,7 @@
 
 use super::hit::{HitBsdf, Mixture, MixturePart};
 use super::tilted_normals::{bump_map_normal, normal_map_normal, tilted_frame};
-use super::{Material, NormalMapOptions, ParameterTexture, ShadingFrame, TexturedParameter};
+use super::{Material, NormalMapOptions, ParameterTexture, ShadingFrame};
 use crate::mesh::AttributeSite;
 use crate::texture::{Texture, TextureLookup};
 use glam::{Vec2, Vec3};
@@ -229,7 +229,7 @@ impl Surface {
             } else {
                 Cow::Owned(textured(material, textures, point))
             };
-            let frame = point.frame(material.two_sided);
+            let frame = point.frame_for(&material);
             return (HitBsdf::Single { material, frame }, frame);
         }
         let mut mixture = Mixture::default();
@@ -243,7 +243,7 @@ impl Surface {
         match self {
             Surface::Material { material, textures } => {
                 let material = textured(material, textures, point);
-                let frame = point.frame(material.two_sided);
+                let frame = point.frame_for(&material);
                 mixture.parts.push(MixturePart {
                     weight: share,
                     material,
@@ -290,9 +290,10 @@ fn textured(material: &Material, textures: &[ParameterTexture], point: &SurfaceP
     let mut material = material.clone();
     let lookup = point.lookup();
     for ParameterTexture { parameter, texture } in textures {
-        let value = match parameter {
-            TexturedParameter::Roughness => Vec3::splat(texture.eval_scalar_at(&lookup)),
-            _ => texture.eval_at(&lookup),
+        let value = if parameter.is_scalar() {
+            Vec3::splat(texture.eval_scalar_at(&lookup))
+        } else {
+            texture.eval_at(&lookup)
         };
         material.set_parameter(*parameter, value);
     }
@@ -306,6 +307,20 @@ impl SurfacePoint<'_> {
             uv: self.uv,
             attributes: self.attributes,
         }
+    }
+
+    /// The shading frame of `material` here: along the tangent for an anisotropic one.
+    fn frame_for(&self, material: &Material) -> ShadingFrame {
+        if material.is_anisotropic() {
+            return ShadingFrame::along_tangent(
+                self.shading_normal,
+                self.geometric_normal,
+                self.wo,
+                material.two_sided,
+                self.dp_du,
+            );
+        }
+        self.frame(material.two_sided)
     }
 
     /// The shading frame here for a material that is (or not) two-sided.

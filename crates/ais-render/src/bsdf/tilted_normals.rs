@@ -108,14 +108,20 @@ pub fn tilted_frame(
         local = Vec3::new(-local.x, -local.y, local.z);
     }
     let local = local.normalize_or(Vec3::Z);
-    let normal = (s * local.x + t * local.y + base.normal * local.z).normalize();
+    let to_world = |v: Vec3| s * v.x + t * v.y + base.normal * v.z;
+    let normal = to_world(local).normalize();
+    // Mitsuba's tilted tangent: the frame's x axis made perpendicular to the tilted normal
+    // (what an anisotropic material's roughness is measured along).
+    let tangent_local = (Vec3::X - local * local.x).normalize_or(Vec3::X);
+    let tangent = to_world(tangent_local).normalize();
+    let bitangent = normal.cross(tangent);
     let alpha2 = if options.use_shadowing_function {
         let z2 = local.z * local.z;
         (0.125 * (1.0 - z2) / z2.max(f32::MIN_POSITIVE)).min(1.0)
     } else {
         0.0
     };
-    let frame = ShadingFrame::with_normal(normal, base.geometric);
+    let frame = ShadingFrame::from_axes(normal, base.geometric, tangent, bitangent);
     let tilt = Tilt {
         base_normal: base.normal,
         alpha2,
