@@ -294,7 +294,15 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
         "checkerboard" => &["color0", "color1", "to_uv"],
         "rawconstant" => &["value"],
         "mesh_attribute" => &["name", "scale"],
-        _ => &["filename", "filter_type", "wrap_mode", "raw", "to_uv"],
+        // `format` only chooses Mitsuba's storage precision; ais stores f32.
+        _ => &[
+            "filename",
+            "filter_type",
+            "wrap_mode",
+            "raw",
+            "to_uv",
+            "format",
+        ],
     }
 }
 

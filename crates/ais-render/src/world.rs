@@ -79,14 +79,6 @@ impl ShapeSurfaces {
             None if shape.emitter.is_some() => Arc::new(Material::diffuse(Vec3::ZERO).into()),
             None => Arc::new(Material::default().into()),
         };
-        if surface.is_textured() && rotated_sphere(shape) {
-            warnings.push(format!(
-                "{}:{}: a textured sphere's texture coordinates ignore the rotation in its \
-                 to_world (they follow the world's axes)",
-                description.file.display(),
-                shape.line
-            ));
-        }
         self.per_shape.push(surface);
         Ok(())
     }
@@ -124,17 +116,14 @@ fn check_attributes(
     }
 }
 
-/// Whether `shape` is a sphere whose `to_world` rotates it.
-fn rotated_sphere(shape: &scene::ShapeDescription) -> bool {
-    if !matches!(shape.geometry, scene::ShapeGeometry::Sphere { .. }) {
-        return false;
-    }
-    let rotation = glam::DMat3::from_mat4(shape.to_world);
-    let scale = rotation.x_axis.length();
-    (rotation - glam::DMat3::from_diagonal(glam::DVec3::splat(scale)))
-        .to_cols_array()
-        .iter()
-        .any(|x| x.abs() > 1e-9 * scale.max(1.0))
+/// The rotation in a sphere's `to_world` (its uniform scale divided out), if it rotates.
+fn sphere_rotation(shape: &scene::ShapeDescription) -> Option<glam::Mat3> {
+    let linear = glam::DMat3::from_mat4(shape.to_world);
+    let scale = linear.x_axis.length();
+    let rotation = linear * (1.0 / scale.max(f64::MIN_POSITIVE));
+    let identity = (rotation - glam::DMat3::IDENTITY).to_cols_array();
+    let rotates = identity.iter().any(|x| x.abs() > 1e-9);
+    (rotates && rotation.is_finite()).then(|| rotation.as_mat3())
 }
 
 /// What an area emitter sends from its front side: a radiance, times a texture's value
@@ -207,6 +196,7 @@ fn sphere_shape(
     let input = ShapeInput {
         geometry,
         flip_normals: shape.flip_normals,
+        rotation: sphere_rotation(shape),
     };
     Ok(BuiltShape { input, light })
 }
@@ -259,6 +249,7 @@ fn build_shape(
     let input = ShapeInput {
         geometry: ShapeGeometry::Mesh(checked.mesh),
         flip_normals: shape.flip_normals,
+        rotation: None,
     };
     Ok(BuiltShape { input, light })
 }

@@ -60,6 +60,7 @@ fn a_ray_from_inside_a_sphere_meets_its_far_side() {
             radius: 0.5,
         }),
         flip_normals: false,
+        rotation: None,
     }]);
     let ray = Ray::new(Vec3::new(1.0, 2.0, 3.1), Vec3::Z);
     let hit = geometry.intersect(&ray).expect("the sphere's far side");
@@ -78,6 +79,7 @@ fn rectangle_from_mitsuba_transform() {
     let geometry = Geometry::build(vec![ShapeInput {
         geometry: ShapeGeometry::Mesh(mesh),
         flip_normals: false,
+        rotation: None,
     }]);
     let hit = geometry
         .intersect(&Ray::new(Vec3::new(1.9, -1.9, 0.0), Vec3::Z))
@@ -90,6 +92,7 @@ fn rectangle_from_mitsuba_transform() {
     let flipped = Geometry::build(vec![ShapeInput {
         geometry: ShapeGeometry::Mesh(shapes::rectangle().transformed(to_world, false, true)),
         flip_normals: true,
+        rotation: None,
     }]);
     let hit = flipped.intersect(&Ray::new(Vec3::ZERO, Vec3::Z)).unwrap();
     assert!((hit.geometric_normal + Vec3::Z).length() < 1e-6);
@@ -108,6 +111,7 @@ fn random_scene(rng: &mut Pcg32) -> Geometry {
     let mut shapes = vec![ShapeInput {
         geometry: ShapeGeometry::Mesh(mesh),
         flip_normals: false,
+        rotation: None,
     }];
     for _ in 0..50 {
         shapes.push(ShapeInput {
@@ -116,6 +120,7 @@ fn random_scene(rng: &mut Pcg32) -> Geometry {
                 radius: 0.1 + 0.4 * rng.next_f32(),
             }),
             flip_normals: false,
+            rotation: None,
         });
     }
     Geometry::build(shapes)
@@ -204,10 +209,12 @@ fn offset_rays_do_not_hit_the_surface_they_leave() {
         ShapeInput {
             geometry: ShapeGeometry::Sphere(sphere),
             flip_normals: false,
+            rotation: None,
         },
         ShapeInput {
             geometry: ShapeGeometry::Mesh(mesh),
             flip_normals: false,
+            rotation: None,
         },
     ]);
     let mut tested = 0;

@@ -186,6 +186,7 @@ fn shapes_and_lights() -> (Vec<ShapeInput>, Vec<AreaLight>) {
     let mesh = |mesh| ShapeInput {
         geometry: ShapeGeometry::Mesh(mesh),
         flip_normals: false,
+        rotation: None,
     };
     let mut inputs = vec![mesh(valid_sculpture()), mesh(ground), mesh(panel)];
     let mut lights = vec![panel_light];
@@ -197,6 +198,7 @@ fn shapes_and_lights() -> (Vec<ShapeInput>, Vec<AreaLight>) {
         inputs.push(ShapeInput {
             geometry: ShapeGeometry::Sphere(sphere),
             flip_normals: false,
+            rotation: None,
         });
         lights.push(AreaLight {
             shape: AreaShape::Sphere {

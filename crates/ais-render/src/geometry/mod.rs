@@ -33,6 +33,9 @@ pub struct ShapeInput {
     pub geometry: ShapeGeometry,
     /// Whether to flip its normals (Mitsuba's `flip_normals`).
     pub flip_normals: bool,
+    /// A sphere's rotation from its own frame to the world's (its `to_world` without the
+    /// scale), which its texture coordinates and tangents follow; `None`: none.
+    pub rotation: Option<glam::Mat3>,
 }
 
 /// A ray-surface intersection.
@@ -82,6 +85,8 @@ pub struct Geometry {
     sources: Vec<PrimitiveSource>,
     meshes: Vec<MeshShading>,
     shape_flips: Vec<bool>,
+    /// Per shape, the rotation of a rotated sphere (world to its own frame).
+    sphere_rotations: Vec<Option<glam::Mat3>>,
     accelerator: Option<Accelerator>,
     triangle_count: usize,
     /// Centre and radius of a sphere around everything.
@@ -118,6 +123,7 @@ impl Geometry {
             sources: Vec::new(),
             meshes: Vec::new(),
             shape_flips: Vec::new(),
+            sphere_rotations: Vec::new(),
             accelerator: None,
             triangle_count: 0,
             bounds: (Vec3::ZERO, 0.0),
@@ -135,6 +141,8 @@ impl Geometry {
     /// Appends a shape's primitives.
     fn add(&mut self, shape_index: u32, shape: ShapeInput) {
         self.shape_flips.push(shape.flip_normals);
+        self.sphere_rotations
+            .push(shape.rotation.map(|r| r.transpose()));
         match shape.geometry {
             ShapeGeometry::Sphere(sphere) => {
                 self.primitives.push(Primitive::Sphere(sphere));
@@ -325,8 +333,12 @@ impl Geometry {
         let (geometric_normal, shading_normal, uv, [dp_du, dp_dv]) = match &self.packed[index] {
             Packed::Sphere(s) => {
                 let outward = (point - s.center).normalize();
-                let uv = sphere_texcoords(outward);
-                let partials = sphere_partials(outward, s.radius);
+                // Texture coordinates and tangents in the sphere's own frame.
+                let rotation = self.sphere_rotations[source.shape as usize];
+                let local = rotation.map_or(outward, |to_local| to_local * outward);
+                let uv = sphere_texcoords(local);
+                let partials = sphere_partials(local, s.radius)
+                    .map(|v| rotation.map_or(v, |to_local| to_local.transpose() * v));
                 (outward * flip, outward * flip, uv, partials)
             }
             Packed::Triangle([_, e1, e2]) => {
