@@ -142,13 +142,7 @@ impl ShadingFrame {
         } else {
             (shading_normal, geometric_normal)
         };
-        let (tangent, bitangent) = basis(normal);
-        ShadingFrame {
-            normal,
-            geometric,
-            tangent,
-            bitangent,
-        }
+        Self::with_normal(normal, geometric)
     }
 
     /// [`ShadingFrame::oriented`] with its tangent along `dp_du` (made perpendicular to the
@@ -169,12 +163,12 @@ impl ShadingFrame {
         let bitangent = shading_normal.cross(tangent);
         let flip = two_sided && geometric_normal.dot(wo) < 0.0;
         let sign = if flip { -1.0 } else { 1.0 };
-        ShadingFrame {
-            normal: shading_normal * sign,
-            geometric: geometric_normal * sign,
+        Self::from_axes(
+            shading_normal * sign,
+            geometric_normal * sign,
             tangent,
             bitangent,
-        }
+        )
     }
 
     /// A frame of unit, orthogonal `tangent`, `bitangent` and `normal`, with `geometric` on
@@ -191,12 +185,7 @@ impl ShadingFrame {
     /// A frame around `normal` (unit), with `geometric` on its side.
     pub fn with_normal(normal: Vec3, geometric: Vec3) -> Self {
         let (tangent, bitangent) = basis(normal);
-        ShadingFrame {
-            normal,
-            geometric,
-            tangent,
-            bitangent,
-        }
+        Self::from_axes(normal, geometric, tangent, bitangent)
     }
 
     /// Local coordinates → world.
