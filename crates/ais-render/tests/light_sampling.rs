@@ -8,8 +8,8 @@ use ais::mapping::LatLong;
 use ais::rng::Pcg32;
 use ais::testing::{ChiSquareTest, Drawn};
 use ais_render::bsdf::{
-    Dielectric, Fraction, Material, Microfacet, MicrofacetKind, RoughDielectric, RoughPlastic,
-    Scattering, ShadingFrame, SmoothPlastic, Surface, SurfacePoint,
+    Dielectric, Fraction, Material, Microfacet, MicrofacetKind, PolarizedPlastic, RoughDielectric,
+    RoughPlastic, Scattering, ShadingFrame, SmoothPlastic, Surface, SurfacePoint,
 };
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
@@ -485,6 +485,29 @@ fn conductor_sampling_fits_for_both_distributions() {
     }
 }
 
+fn polarized_plastic(microfacet: Microfacet) -> Material {
+    Material {
+        scattering: Scattering::PolarizedPlastic(PolarizedPlastic::new(
+            microfacet,
+            1.49,
+            Vec3::new(0.5, 0.3, 0.2),
+            Vec3::ONE,
+        )),
+        two_sided: false,
+    }
+}
+
+#[test]
+fn polarized_plastic_sampling_fits() {
+    for microfacet in [
+        Microfacet::beckmann(0.2),
+        Microfacet::anisotropic(MicrofacetKind::Ggx, 0.1, 0.4),
+    ] {
+        let label = format!("pplastic, {microfacet:?}");
+        assert_sampling_fits(&polarized_plastic(microfacet), 70, &views(), &label);
+    }
+}
+
 #[test]
 fn rough_plastic_sampling_fits() {
     let material = plastic(0.25, Vec3::new(0.6, 0.3, 0.2));
@@ -653,6 +676,7 @@ fn microfacet_bsdfs_do_not_create_energy() {
         conductor(Microfacet::anisotropic(MicrofacetKind::Ggx, 0.1, 0.6)),
         conductor(Microfacet::anisotropic(MicrofacetKind::Beckmann, 0.6, 0.1)),
         plastic(0.3, Vec3::ONE),
+        polarized_plastic(Microfacet::ggx(0.3)),
         // Seen from outside: reflection plus transmission (radiance scaled by 1/η²).
         rough_glass(Microfacet::ggx(0.3)),
     ] {

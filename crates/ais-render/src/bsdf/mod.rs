@@ -6,6 +6,7 @@ mod conductors;
 mod hit;
 mod microfacet;
 mod parameter_textures;
+mod polarized_plastic;
 mod reader;
 mod rough_dielectric;
 mod rough_plastic;
@@ -21,6 +22,7 @@ pub(crate) use parameter_textures::parameter_texture;
 pub use parameter_textures::{
     material_textures, ParameterTexture, TextureScene, TexturedParameter,
 };
+pub use polarized_plastic::PolarizedPlastic;
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
@@ -70,6 +72,8 @@ pub enum Scattering {
     Dielectric(Dielectric),
     /// Mitsuba's `roughdielectric`: rough reflection and transmission, from either side.
     RoughDielectric(RoughDielectric),
+    /// Mitsuba's `pplastic`, unpolarized: microfacet reflection over a diffuse base.
+    PolarizedPlastic(PolarizedPlastic),
 }
 
 /// A direction drawn from a BSDF.
@@ -210,6 +214,7 @@ impl Material {
         match &self.scattering {
             Scattering::RoughConductor { microfacet, .. } => microfacet.is_anisotropic(),
             Scattering::RoughDielectric(rough) => rough.microfacet.is_anisotropic(),
+            Scattering::PolarizedPlastic(plastic) => plastic.microfacet.is_anisotropic(),
             _ => false,
         }
     }
@@ -285,6 +290,7 @@ impl Material {
             Scattering::RoughPlastic(ref plastic) => plastic.eval(o, i),
             Scattering::Plastic(ref plastic) => plastic.eval(o, i),
             Scattering::RoughDielectric(ref rough) => rough.eval(o, i),
+            Scattering::PolarizedPlastic(ref plastic) => plastic.eval(o, i),
             // No continuous part (outside the support).
             Scattering::Conductor { .. } | Scattering::Dielectric(_) => Vec3::ZERO,
         }
@@ -318,6 +324,9 @@ impl Material {
             Scattering::Plastic(ref plastic) => plastic.sample(o, u)?,
             Scattering::RoughDielectric(ref rough) => {
                 specular::LobeSample::Continuous(rough.sample(o, u)?)
+            }
+            Scattering::PolarizedPlastic(ref plastic) => {
+                specular::LobeSample::Continuous(plastic.sample(o, u)?)
             }
             Scattering::Conductor { eta, k, specular } => {
                 specular::LobeSample::Specular(specular::conductor_lobe(o, eta, k, specular)?)
@@ -378,6 +387,7 @@ impl Material {
                 }
                 plastic.pdf(o, i)
             }
+            Scattering::PolarizedPlastic(ref plastic) => plastic.pdf(o, i),
             // Point masses only: no density over directions (the rough dielectric returned
             // above).
             Scattering::Conductor { .. }

@@ -69,6 +69,13 @@ pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, Textur
             ("specular_reflectance", SpecularReflectance),
         ],
         "conductor" => &[("specular_reflectance", SpecularReflectance)],
+        "pplastic" => &[
+            ("diffuse_reflectance", Albedo),
+            ("specular_reflectance", SpecularReflectance),
+            ("alpha", Roughness),
+            ("alpha_u", RoughnessU),
+            ("alpha_v", RoughnessV),
+        ],
         "roughconductor" => &[
             ("specular_reflectance", SpecularReflectance),
             ("alpha", Roughness),
@@ -174,6 +181,15 @@ impl Material {
             }
             (Scattering::Plastic(plastic), SpecularReflectance) => {
                 *plastic = plastic.with_specular(colour)
+            }
+            (Scattering::PolarizedPlastic(plastic), Albedo) => {
+                *plastic = plastic.with_diffuse(albedo)
+            }
+            (Scattering::PolarizedPlastic(plastic), SpecularReflectance) => {
+                *plastic = plastic.with_specular(colour)
+            }
+            (Scattering::PolarizedPlastic(plastic), Roughness | RoughnessU | RoughnessV) => {
+                plastic.microfacet = with_roughness(plastic.microfacet, parameter, value.x)
             }
             (
                 Scattering::RoughConductor { specular, .. }

@@ -3,8 +3,8 @@
 //! line.
 
 use super::{
-    named_conductor, Dielectric, Material, Microfacet, MicrofacetKind, RoughDielectric,
-    RoughPlastic, Scattering, SmoothPlastic,
+    named_conductor, Dielectric, Material, Microfacet, MicrofacetKind, PolarizedPlastic,
+    RoughDielectric, RoughPlastic, Scattering, SmoothPlastic,
 };
 use crate::error::InputError;
 use crate::scene::{ColourRole, Plugin, Property};
@@ -81,6 +81,17 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
             "ext_ior",
             "specular_reflectance",
             "specular_transmittance",
+        ],
+        "pplastic" => &[
+            "distribution",
+            "alpha",
+            "alpha_u",
+            "alpha_v",
+            "int_ior",
+            "ext_ior",
+            "diffuse_reflectance",
+            "specular_reflectance",
+            "sample_visible",
         ],
         "roughplastic" => &[
             "distribution",
@@ -192,6 +203,7 @@ impl BsdfReader<'_> {
             "dielectric" => self.dielectric(false),
             "thindielectric" => self.dielectric(true),
             "roughdielectric" => self.rough_dielectric(),
+            "pplastic" => self.polarized_plastic(),
             "twosided" => Material {
                 two_sided: true,
                 ..self.nested()?
@@ -398,6 +410,21 @@ impl BsdfReader<'_> {
                 .min(Vec3::ONE),
             specular: self.colour("specular_reflectance", Vec3::ONE),
             nonlinear: self.plugin.boolean("nonlinear", false).unwrap_or(false),
+        }
+    }
+
+    /// `pplastic` (unpolarized): Beckmann unless GGX is named, polypropylene in air.
+    fn polarized_plastic(&mut self) -> Material {
+        let microfacet = self.microfacet(true);
+        let coat = self.coating();
+        Material {
+            scattering: Scattering::PolarizedPlastic(PolarizedPlastic::new(
+                microfacet,
+                coat.eta,
+                coat.diffuse,
+                coat.specular,
+            )),
+            two_sided: false,
         }
     }
 
