@@ -360,6 +360,10 @@ fn mesh_attribute(file: &Path, plugin: &Plugin) -> Result<Texture, InputError> {
         return Err(InputError::at(file, plugin.line, message));
     }
     let scale = plugin.float("scale", 1.0).map_err(at)? as f32;
+    if !scale.is_finite() {
+        let message = format!("a mesh_attribute's scale must be finite, not {scale}");
+        return Err(InputError::at(file, plugin.line, message));
+    }
     Ok(Texture::MeshAttribute {
         name: name.to_string(),
         scale,

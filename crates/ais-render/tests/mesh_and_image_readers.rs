@@ -121,6 +121,31 @@ fn ply_ascii_and_binary() {
 }
 
 #[test]
+fn ply_attributes_follow_fanned_and_dropped_faces() {
+    let path = scratch("attributes.ply");
+    let header = "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\n\
+                  property float z\nproperty float r\nproperty float g\nproperty float b\n\
+                  element face 2\nproperty list uchar int vertex_indices\nproperty float w_0\n\
+                  end_header\n";
+    let body = "0 0 0 1 0 0\n1 0 0 0 1 0\n1 1 0 0 0 1\n0 1 0 1e39 1 1\n2 2 2 1 1 1\n\
+                4 0 1 2 3 0.25\n3 4 4 4 0.75\n";
+    std::fs::write(&path, format!("{header}{body}")).unwrap();
+    let loaded = load_mesh(&path, MeshFormat::Ply).unwrap();
+    let mesh = &loaded.mesh;
+    // The quad fans into two triangles that keep its weight; the degenerate face is dropped.
+    assert_eq!(mesh.triangles.len(), 2);
+    let names: Vec<&str> = mesh.attributes.iter().map(|a| a.name.as_str()).collect();
+    assert_eq!(names, ["vertex_color", "face_w"]);
+    assert_eq!(mesh.attributes[1].values, [0.25, 0.25]);
+    // An infinite value becomes 0, with a warning.
+    assert_eq!(mesh.attributes[0].values[9], 0.0);
+    assert!(loaded
+        .warnings
+        .iter()
+        .any(|w| w.contains("1 attribute value(s) were NaN")));
+}
+
+#[test]
 fn glb_plain_and_draco() {
     let plain = scratch("triangle.glb");
     std::fs::write(&plain, common::glb(false)).unwrap();

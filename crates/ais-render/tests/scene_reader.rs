@@ -600,6 +600,18 @@ fn masks_blends_and_null_are_read_and_checked() {
         &shape(r#"<bsdf type="mask"><ref id="nowhere"/></bsdf>"#),
         "test.xml:3: no <bsdf> with id \"nowhere\"",
     );
+    assert_world_refuses(
+        &shape(
+            r#"<bsdf type="bumpmap"><float name="scale" value="nan"/><texture type="checkerboard"/><bsdf type="diffuse"/></bsdf>"#,
+        ),
+        "test.xml:3: a bumpmap's scale must be finite, not NaN",
+    );
+    assert_world_refuses(
+        &shape(
+            r#"<bsdf type="diffuse"><texture type="mesh_attribute" name="reflectance"><string name="name" value="vertex_color"/><float name="scale" value="inf"/></texture></bsdf>"#,
+        ),
+        "test.xml:3: a mesh_attribute's scale must be finite, not inf",
+    );
     let text = shape(
         r#"<bsdf type="mask"><float name="opacity" value="1.5"/><float name="alpha" value="1"/>
            <bsdf type="twosided"><bsdf type="diffuse"/></bsdf></bsdf>"#,

@@ -38,10 +38,18 @@ impl Microfacet {
 
     /// A distribution of roughness `alpha_u` along the tangent and `alpha_v` across it.
     pub fn anisotropic(kind: MicrofacetKind, alpha_u: f32, alpha_v: f32) -> Self {
+        // A roughness that is not a number (a texture's NaN) counts as the roughest.
+        let clamp = |alpha: f32| {
+            if alpha.is_nan() {
+                1.0
+            } else {
+                alpha.clamp(1e-4, 1.0)
+            }
+        };
         Microfacet {
             kind,
-            alpha_u: alpha_u.clamp(1e-4, 1.0),
-            alpha_v: alpha_v.clamp(1e-4, 1.0),
+            alpha_u: clamp(alpha_u),
+            alpha_v: clamp(alpha_v),
         }
     }
 

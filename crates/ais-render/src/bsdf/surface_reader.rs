@@ -141,6 +141,14 @@ impl<'a> SurfaceReader<'a, '_> {
             ));
         }
         let error = |message: String| InputError::at(self.scene.file, plugin.line, message);
+        let scale = plugin
+            .float("scale", 1.0)
+            .map_err(|(line, message)| InputError::at(self.scene.file, line, message))?;
+        if !scale.is_finite() {
+            return Err(error(format!(
+                "a bumpmap's scale must be finite, not {scale}"
+            )));
+        }
         let scene = self.scene;
         let referenced = plugin.references.iter().find_map(|(_, id, _)| {
             (scene.textures.iter()).find(|t| t.id.as_deref() == Some(id.as_str()))
@@ -156,9 +164,6 @@ impl<'a> SurfaceReader<'a, '_> {
                     .into(),
             ));
         }
-        let scale = plugin
-            .float("scale", 1.0)
-            .map_err(|(line, message)| InputError::at(self.scene.file, line, message))?;
         Ok(TiltedNormals::BumpMap {
             height: Arc::new(height),
             scale: scale as f32,

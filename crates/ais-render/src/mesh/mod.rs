@@ -174,6 +174,17 @@ pub fn validate(path: &Path, mut mesh: TriangleMesh) -> Result<LoadedMesh, Input
         .collect();
     check_attributes(path, &mesh)?;
     keep_triangles(&mut mesh, &kept);
+    let bad: usize = (mesh.attributes.iter_mut())
+        .flat_map(|attribute| attribute.values.iter_mut())
+        .filter(|value| !value.is_finite())
+        .map(|value| *value = 0.0)
+        .count();
+    if bad > 0 {
+        warnings.push(format!(
+            "{}: {bad} attribute value(s) were NaN or infinite and were set to 0",
+            path.display()
+        ));
+    }
     let dropped = before - mesh.triangles.len();
     if dropped > 0 {
         warnings.push(format!(
