@@ -127,8 +127,7 @@ fn spot(
     let file = scene.file;
     let at = |(line, message): (u32, String)| InputError::at(file, line, message);
     let known = ["intensity", "cutoff_angle", "beam_width", "to_world"];
-    scene::warn_unknown(file, plugin, &known, warnings);
-    let to_world = plugin.transform("to_world").map_err(at)?;
+    let frame = pinhole(file, plugin, &known, warnings)?;
     let cutoff = plugin.float("cutoff_angle", 20.0).map_err(at)?;
     let beam = plugin.float("beam_width", cutoff * 0.75).map_err(at)?;
     if !(cutoff.is_finite() && beam.is_finite() && cutoff > 0.0 && cutoff <= 180.0 && beam >= 0.0) {
@@ -138,36 +137,53 @@ fn spot(
             "spot angles must be finite, with 0 < cutoff_angle <= 180 and beam_width >= 0",
         ));
     }
-    let (position, to_local) = pinhole_frame(file, plugin, to_world)?;
     let texture = parameter_texture(plugin, "texture", scene, warnings)?;
     if texture.is_some() && cutoff >= 90.0 {
         let message = "a textured spot's cutoff_angle must be below 90 degrees";
         return Err(InputError::at(file, plugin.line, message));
     }
     Ok(DeltaLight::Spot(Spot {
-        position,
+        position: frame.position,
         intensity: spectrum_property(file, plugin, "intensity")?,
-        to_local: to_local.as_mat3(),
+        to_local: frame.to_local.as_mat3(),
         cutoff_angle: cutoff.to_radians() as f32,
         beam_width: beam.min(cutoff).to_radians() as f32,
         texture: texture.map(Arc::new),
     }))
 }
 
-/// Where a spot or projector sits and its world-to-local rotation, from `to_world` (which
-/// must be invertible, with a finite origin).
-fn pinhole_frame(
+/// Where a spot or projector sits.
+struct Pinhole {
+    /// Its position.
+    position: Vec3,
+    /// World to its frame (the rotation and scale of `to_world`, inverted).
+    to_local: DMat3,
+    /// Its `to_world`.
+    to_world: glam::DMat4,
+}
+
+/// The frame of a spot or projector, whose properties not in `known` are warned of: its
+/// `to_world`, which must be invertible, with a finite origin.
+fn pinhole(
     file: &Path,
     plugin: &Plugin,
-    to_world: glam::DMat4,
-) -> Result<(Vec3, DMat3), InputError> {
+    known: &[&str],
+    warnings: &mut Vec<String>,
+) -> Result<Pinhole, InputError> {
+    scene::warn_unknown(file, plugin, known, warnings);
+    let to_world = (plugin.transform("to_world"))
+        .map_err(|(line, message)| InputError::at(file, line, message))?;
     let rotation = DMat3::from_mat4(to_world);
     if rotation.determinant().abs() < 1e-12 {
         let message = format!("{} to_world is singular", plugin.kind);
         return Err(InputError::at(file, plugin.line, message));
     }
     let position = to_world.transform_point3(DVec3::ZERO);
-    Ok((finite_point(file, plugin, position)?, rotation.inverse()))
+    Ok(Pinhole {
+        position: finite_point(file, plugin, position)?,
+        to_local: rotation.inverse(),
+        to_world,
+    })
 }
 
 /// A `projector`: its `irradiance` image (a texture, or a colour: a 1 × 1 image), `scale`,
@@ -187,9 +203,9 @@ fn projector(
         "fov_axis",
         "focal_length",
     ];
-    scene::warn_unknown(file, plugin, &known, warnings);
-    let to_world = plugin.transform("to_world").map_err(at)?;
-    let (position, _) = pinhole_frame(file, plugin, to_world)?;
+    let Pinhole {
+        position, to_world, ..
+    } = pinhole(file, plugin, &known, warnings)?;
     let irradiance = match parameter_texture(plugin, "irradiance", scene, warnings)? {
         Some(texture) => texture,
         None => Texture::Constant(spectrum_property(file, plugin, "irradiance")?),
