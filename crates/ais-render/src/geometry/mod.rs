@@ -344,8 +344,10 @@ impl Geometry {
             Packed::Triangle([_, e1, e2]) => {
                 let n = e1.cross(*e2).normalize() * flip;
                 let shading = self.interpolated_normal(source, barycentrics).unwrap_or(n);
-                let uv = self.interpolated_texcoords(source, barycentrics);
-                (n, shading, uv, self.uv_partials(source, *e1, *e2))
+                // The triangle's texture coordinates, read once for both uses.
+                let corners = self.triangle_texcoords(source);
+                let uv = interpolated_texcoords(corners, barycentrics);
+                (n, shading, uv, uv_partials(corners, *e1, *e2))
             }
         };
         Hit {
@@ -362,17 +364,11 @@ impl Geometry {
         }
     }
 
-    /// The texture coordinates of a triangle's mesh interpolated at `barycentrics` (zero
-    /// when the mesh has none).
-    fn interpolated_texcoords(&self, source: PrimitiveSource, barycentrics: Vec2) -> Vec2 {
+    /// The texture coordinates at a triangle's corners (None: its mesh has none).
+    fn triangle_texcoords(&self, source: PrimitiveSource) -> Option<[Vec2; 3]> {
         let mesh = &self.meshes[source.mesh as usize];
-        let Some(texcoords) = mesh.texcoords.as_ref() else {
-            return Vec2::ZERO;
-        };
-        let [a, b, c] = mesh.triangles[source.index as usize];
-        texcoords[a as usize] * (1.0 - barycentrics.x - barycentrics.y)
-            + texcoords[b as usize] * barycentrics.x
-            + texcoords[c as usize] * barycentrics.y
+        let texcoords = mesh.texcoords.as_ref()?;
+        Some(mesh.triangles[source.index as usize].map(|i| texcoords[i as usize]))
     }
 
     /// Where the mesh attributes of `hit`'s mesh are looked up (None on a sphere).
@@ -388,25 +384,6 @@ impl Geometry {
             vertices: mesh.triangles[source.index as usize],
             barycentrics: hit.barycentrics,
         })
-    }
-
-    /// ∂p/∂u and ∂p/∂v over a triangle with edges `e1`, `e2`, from its texture coordinates
-    /// (the edges themselves when its mesh has none, zero when they do not span the plane).
-    fn uv_partials(&self, source: PrimitiveSource, e1: Vec3, e2: Vec3) -> [Vec3; 2] {
-        let mesh = &self.meshes[source.mesh as usize];
-        let Some(texcoords) = mesh.texcoords.as_ref() else {
-            return [e1, e2];
-        };
-        let [a, b, c] = mesh.triangles[source.index as usize].map(|i| texcoords[i as usize]);
-        let (duv1, duv2) = (b - a, c - a);
-        let determinant = duv1.x * duv2.y - duv1.y * duv2.x;
-        if determinant.abs() <= f32::MIN_POSITIVE || !determinant.is_finite() {
-            return [Vec3::ZERO; 2];
-        }
-        [
-            (e1 * duv2.y - e2 * duv1.y) / determinant,
-            (e2 * duv1.x - e1 * duv2.x) / determinant,
-        ]
     }
 
     /// The vertex normals of a triangle's mesh interpolated at `barycentrics` (None: the mesh
@@ -433,6 +410,31 @@ pub fn sphere_texcoords(outward: Vec3) -> Vec2 {
         u += 1.0;
     }
     Vec2::new(u, outward.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI)
+}
+
+/// Texture coordinates at `barycentrics` from a triangle's `corners` (zero without them).
+fn interpolated_texcoords(corners: Option<[Vec2; 3]>, barycentrics: Vec2) -> Vec2 {
+    let Some([a, b, c]) = corners else {
+        return Vec2::ZERO;
+    };
+    a * (1.0 - barycentrics.x - barycentrics.y) + b * barycentrics.x + c * barycentrics.y
+}
+
+/// ∂p/∂u and ∂p/∂v over a triangle with edges `e1`, `e2`, from the texture coordinates at
+/// its `corners` (the edges themselves without them, zero when they do not span the plane).
+fn uv_partials(corners: Option<[Vec2; 3]>, e1: Vec3, e2: Vec3) -> [Vec3; 2] {
+    let Some([a, b, c]) = corners else {
+        return [e1, e2];
+    };
+    let (duv1, duv2) = (b - a, c - a);
+    let determinant = duv1.x * duv2.y - duv1.y * duv2.x;
+    if determinant.abs() <= f32::MIN_POSITIVE || !determinant.is_finite() {
+        return [Vec3::ZERO; 2];
+    }
+    [
+        (e1 * duv2.y - e2 * duv1.y) / determinant,
+        (e2 * duv1.x - e1 * duv2.x) / determinant,
+    ]
 }
 
 /// ∂p/∂u and ∂p/∂v on a sphere of `radius` at the unit `outward` direction, for the texture
