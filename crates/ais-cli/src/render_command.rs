@@ -362,9 +362,10 @@ fn print_gather_summary(
     let [rolled, aside] = rendered.output.stats.field_gathers;
     if rolled + aside > 0 {
         println!(
-            "field        {:.1} KiB; roulette in {:.1}% of gathers, stood aside in the rest; cost ratio {:.2}",
+            "field        {:.1} KiB; roulette in {:.1}% of gathers, stood aside in the rest; light sampling guided in {:.1}%; cost ratio {:.2}",
             rendered.output.stats.field_memory as f64 / 1024.0,
             100.0 * rolled as f64 / (rolled + aside) as f64,
+            100.0 * rendered.output.stats.field_guided as f64 / (rolled + aside) as f64,
             rendered.output.stats.field_cost_ratio
         );
     }

@@ -5,9 +5,10 @@
 mod common;
 
 use ais_render::integrators::gather::{
-    Acceptance, GatherSettings, Preset, RayBudget, Sharing, Strategy,
+    Acceptance, GatherSettings, MapUse, Preset, RayBudget, Sharing, Strategy,
 };
 use ais_render::integrators::Integrator;
+use ais_render::render::{render, RenderSettings};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
 use common::{agreement, camera, occluded_scene, PixelStatistics};
@@ -383,6 +384,53 @@ fn every_mode_is_unbiased_with_a_fixed_candidate_budget() {
                 64,
                 &format!("{strategy:?} {mode:?} {sharing:?}, fixed candidates"),
             );
+        }
+    }
+}
+
+/// A shipped scene at 12 × 8 pixels.
+fn small_shipped_scene(name: &str) -> World {
+    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
+    let mut world = World::from_description(load_scene(&scenes.join(name), &[]).unwrap()).unwrap();
+    world.set_resolution((12, 8));
+    world
+}
+
+#[test]
+fn light_sampling_guided_by_the_field_is_unbiased() {
+    // The field learned in each render's first passes guides the environment's draws in the
+    // later ones (alone, and together with roulette), through a window: every pixel agrees
+    // with AIS off. The interior's sky is an environment map; the overcast room's a
+    // constant.
+    let cases = [
+        ("interior.xml", Strategy::Mis, MapUse::Proposal),
+        ("interior.xml", Strategy::Light, MapUse::Proposal),
+        ("interior.xml", Strategy::Mis, MapUse::Both),
+        ("overcast_room.xml", Strategy::Mis, MapUse::Both),
+    ];
+    for (scene, strategy, map_use) in cases {
+        let world = small_shipped_scene(scene);
+        let off = settings(Strategy::Mis, Preset::Off, 64);
+        let reference = pixel_statistics(&world, off, 32, 16);
+        let gather = GatherSettings {
+            budget: RayBudget::Candidates,
+            map_use,
+            ..settings(strategy, Preset::Auto, 64)
+        };
+        let settings = RenderSettings {
+            samples_per_pixel: 8,
+            seed: 1,
+            progress: false,
+            crop: None,
+        };
+        let output = render(&world, &Integrator::Gather(gather), &settings);
+        assert!(
+            output.stats.field_guided > 0,
+            "the field guides some gathers"
+        );
+        let statistics = pixel_statistics(&world, gather, 8, 48);
+        if let Err(message) = agreement(&statistics, &reference) {
+            panic!("{scene} {strategy:?} {map_use:?}: {message}");
         }
     }
 }

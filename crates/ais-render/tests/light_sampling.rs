@@ -15,11 +15,12 @@ use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
 use ais_render::integrators::gather::{GatherPoint, Strategy};
 use ais_render::lights::{
-    AreaLight, AreaShape, Emitters, Environment, EnvironmentGuide, EnvironmentMap, Lights,
-    Receiver, Rectangle, Toward,
+    AreaLight, AreaShape, Emitters, Environment, EnvironmentGuide, EnvironmentMap,
+    EnvironmentPartition, GuideLayout, Lights, Receiver, Rectangle, Toward,
 };
 use base64::Engine;
 use glam::{DMat3, Vec3};
+use std::sync::Arc;
 
 const SIGNIFICANCE: f64 = 0.01;
 
@@ -138,29 +139,54 @@ fn environment_guided_by_an_affinity_map_fits() {
     let mut guide = EnvironmentGuide::new(map.partition(layout));
     // Uneven affinities, the sun's texel among the smallest.
     let sun_texel = layout.texel(map.brightest_direction());
-    guide.set_affinities(|t| {
+    guide.set_affinities(|index| {
+        let t = layout.texel_of_index(index);
         if t == sun_texel {
             1e-3
         } else {
             0.05 + ((t.row * 7 + t.column * 3) % 5) as f32 * 0.2
         }
     });
-    for (seed, fraction) in [(20, 1.0), (21, 0.5)] {
+    assert_guide_fits(Environment::Map(Box::new(map)), &mut guide, 20);
+}
+
+/// A constant environment drawn from its product with a visibility field cell's
+/// octahedral texels, and a map drawn through the same texels.
+#[test]
+fn environment_guided_by_octahedral_texels_fits() {
+    let uneven = |index: usize| 0.02 + ((index * 7) % 5) as f32 * 0.25;
+    let mut constant = EnvironmentGuide::new(Arc::new(EnvironmentPartition::uniform(8)));
+    constant.set_affinities(uneven);
+    assert_guide_fits(Environment::Constant(Vec3::ONE), &mut constant, 50);
+    let rotation = DMat3::from_rotation_x(0.5) * DMat3::from_rotation_z(0.3);
+    let map = EnvironmentMap::new(gradient_with_sun(64, 32), rotation);
+    let mut guide = EnvironmentGuide::new(map.partition(GuideLayout::Octahedral(8)));
+    guide.set_affinities(uneven);
+    assert_guide_fits(Environment::Map(Box::new(map)), &mut guide, 40);
+}
+
+/// Chi-square fits of `guide` over `environment`: the product alone and the defensive
+/// mixture, then light sampling and MIS at a gather point with the guide.
+fn assert_guide_fits(environment: Environment, guide: &mut EnvironmentGuide, seed: u64) {
+    for (seed, fraction) in [(seed, 1.0), (seed + 1, 0.5)] {
         guide.set_fraction(fraction);
         let p = fit(
             200_000,
             seed,
             |u| {
-                let mut toward = guide.sample(&map, u);
-                Some((toward.direction, guide.pdf(&map, &mut toward)))
+                let mut toward = guide.sample(&environment, u);
+                Some((toward.direction, guide.pdf(&environment, &mut toward)))
             },
-            |d| guide.pdf(&map, &mut Toward::new(d)),
+            |d| guide.pdf(&environment, &mut Toward::new(d)),
         );
-        assert!(p > SIGNIFICANCE, "fraction {fraction}: p = {p}");
+        assert!(
+            p > SIGNIFICANCE,
+            "seed {seed}, fraction {fraction}: p = {p}"
+        );
     }
     let lights = Lights::new(
         Emitters {
-            environment: Some(Environment::Map(Box::new(map))),
+            environment: Some(environment),
             ..Default::default()
         },
         0,
@@ -169,13 +195,13 @@ fn environment_guided_by_an_affinity_map_fits() {
     let surface = Surface::from(Material::default());
     let (bsdf, frame) = surface.at(&surface_point());
     let at = GatherPoint {
-        receiver: Receiver::guided(Vec3::ZERO, &guide),
+        receiver: Receiver::guided(Vec3::ZERO, guide),
         frame,
         wo: surface_point().wo,
         bsdf,
         lights: &lights,
     };
-    for (seed, strategy) in [(22, Strategy::Light), (23, Strategy::Mis)] {
+    for (seed, strategy) in [(seed + 2, Strategy::Light), (seed + 3, Strategy::Mis)] {
         let p = fit(
             200_000,
             seed,

@@ -4,7 +4,7 @@
 use ais_render::default_scene::default_world;
 use ais_render::film::ReconstructionFilter;
 use ais_render::integrators::gather::{self, GatherStats};
-use ais_render::integrators::gather::{Acceptance, GatherSettings, Preset, Sharing};
+use ais_render::integrators::gather::{Acceptance, GatherSettings, MapUse, Preset, Sharing};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
 use ais_render::render::{render, PixelRect, RenderOutput, RenderSettings};
 use ais_render::scene::load_scene;
@@ -164,24 +164,29 @@ fn the_learned_field_is_thread_independent_and_used() {
         World::from_description(load_scene(&scenes.join("interior.xml"), &[]).unwrap()).unwrap();
     world.set_resolution((48, 27));
     // The measured cost ratio depends on timing; pinned, the image is reproducible. A low
-    // ratio (rays dear next to the rest of a candidate's work) makes roulette pay in some cells.
-    let auto = Integrator::Gather(GatherSettings {
-        cost_ratio: Some(0.05),
-        rays: 128,
-        ..GatherSettings::preset(Preset::Auto)
-    });
-    let one = on_threads(&world, 1, auto);
-    let two = on_threads(&world, 2, auto);
-    assert_eq!(bits(&one.image), bits(&two.image));
-    assert_eq!(one.stats.ais, two.stats.ais);
-    assert_eq!(one.stats.field_gathers, two.stats.field_gathers);
-    let [rolled, aside] = one.stats.field_gathers;
-    assert!(
-        rolled > 0 && aside > 0,
-        "{rolled} gathers used the field, {aside} did not"
-    );
-    assert!(one.stats.ais.rejected_roulette > 0, "the field rejects");
-    assert!(one.stats.field_memory > 0);
+    // ratio (rays dear next to the rest of a candidate's work) makes roulette pay in some
+    // cells. With `map_use = both` the field also guides light sampling.
+    for map_use in [MapUse::Roulette, MapUse::Both] {
+        let auto = Integrator::Gather(GatherSettings {
+            cost_ratio: Some(0.05),
+            rays: 128,
+            map_use,
+            ..GatherSettings::preset(Preset::Auto)
+        });
+        let one = on_threads(&world, 1, auto);
+        let two = on_threads(&world, 2, auto);
+        assert_eq!(bits(&one.image), bits(&two.image), "{map_use:?}");
+        assert_eq!(one.stats.ais, two.stats.ais);
+        assert_eq!(one.stats.field_gathers, two.stats.field_gathers);
+        let [rolled, aside] = one.stats.field_gathers;
+        assert!(
+            rolled > 0 && aside > 0,
+            "{rolled} gathers used the field, {aside} did not"
+        );
+        assert!(one.stats.ais.rejected_roulette > 0, "the field rejects");
+        assert!(one.stats.field_memory > 0);
+        assert_eq!(one.stats.field_guided > 0, map_use == MapUse::Both);
+    }
 }
 
 #[test]

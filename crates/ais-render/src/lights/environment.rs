@@ -180,9 +180,9 @@ impl EnvironmentMap {
     /// Its cells grouped by the texels of `layout` (built once, then shared).
     pub fn partition(
         &self,
-        layout: ais::mapping::LatLong,
+        layout: impl Into<super::GuideLayout>,
     ) -> std::sync::Arc<super::EnvironmentPartition> {
-        self.partitions.get(self, layout)
+        self.partitions.get(self, layout.into())
     }
 
     /// The centre of the cell that sampling picks most often (the sun, in a sky).

@@ -1,44 +1,95 @@
-//! Environment sampling multiplied by a fixed affinity map: the exact product
+//! Environment sampling multiplied by a fixed piecewise-constant weight over directions (an
+//! affinity map's texels, or a visibility field cell's): the exact product
 //! `p_env(ω) · A(ω) / Z`, sampled without rejection.
 //!
-//! Every cell of the environment's sampling distribution is assigned to the map texel that
-//! holds its centre, so each map texel owns a set of whole cells and its share of the
-//! environment's probability, `P_t`. With the map's affinities `A_t` held fixed for a batch,
+//! Every cell of the environment's sampling distribution is assigned to the texel that
+//! holds its centre, so each texel owns a set of whole cells and its share of the
+//! environment's probability, `P_t`. With the weights `A_t` held fixed for a batch,
 //! the product density picks texel `t` with probability `A_t P_t / Z` (`Z = Σ A_t P_t`),
-//! then a cell of it in proportion to the environment's own cell probabilities, then a point
-//! in the cell exactly as the environment does. Its density is therefore
-//! `p_env(ω) · A_{t(ω)} / Z`, known in closed form: a light sample that follows the map, for
-//! the price of two short inversions and no rejected candidate. Inversion all the way down
-//! keeps stratified `u` stratified.
+//! then a cell of it in proportion to the environment's own cell probabilities (an alias
+//! table per texel), then a point in the cell exactly as the environment does. Its density
+//! is therefore `p_env(ω) · A_{t(ω)} / Z`, known in closed form: a light sample that
+//! follows the map, for the price of a short inversion and an alias draw, and no rejected
+//! candidate.
 
-use super::{EnvironmentMap, Toward};
-use ais::mapping::{LatLong, Texel};
+use super::{Environment, EnvironmentMap, Toward};
+use ais::field::octahedral;
+use ais::mapping::LatLong;
+use ais::sampling::AliasTable;
+use glam::Vec3;
 use std::sync::{Arc, Mutex};
 
-/// The environment's cells grouped by the texels of one map layout: built once per
+/// The texels a guide weighs: how world directions are binned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GuideLayout {
+    /// An affinity map's lat-long texels (guided gathers with shared maps).
+    LatLong(LatLong),
+    /// A visibility field cell's equal-area octahedral texels, `side × side`.
+    Octahedral(u32),
+}
+
+impl GuideLayout {
+    /// Number of texels.
+    pub fn texel_count(self) -> usize {
+        match self {
+            GuideLayout::LatLong(layout) => layout.texel_count(),
+            GuideLayout::Octahedral(side) => (side * side) as usize,
+        }
+    }
+
+    /// The index of the texel holding `direction` (unit, world space).
+    pub fn index(self, direction: Vec3) -> usize {
+        match self {
+            GuideLayout::LatLong(layout) => layout.index(layout.texel(direction)),
+            GuideLayout::Octahedral(side) => octahedral::texel_of(direction.into(), side),
+        }
+    }
+}
+
+impl From<LatLong> for GuideLayout {
+    fn from(layout: LatLong) -> Self {
+        GuideLayout::LatLong(layout)
+    }
+}
+
+/// What a texel of a partition holds, and how a direction is drawn in it.
+#[derive(Debug)]
+enum TexelContents {
+    /// Whole cells of an environment map, each assigned to the texel of its centre.
+    Cells {
+        /// The texel of every environment cell.
+        cell_texel: Vec<u32>,
+        /// Environment cells grouped by texel: texel `t` owns `cells[start[t]..start[t + 1]]`.
+        cells: Vec<u32>,
+        start: Vec<u32>,
+        /// Per texel, its cells in proportion to their probabilities (O(1) draws).
+        within: Vec<AliasTable>,
+    },
+    /// A constant environment's uniform directions over equal-area octahedral texels: a
+    /// point uniform in the texel's square is uniform over its solid angle.
+    Uniform {
+        /// Texels per side.
+        side: u32,
+    },
+}
+
+/// The environment's cells grouped by the texels of one layout: built once per
 /// environment and layout, shared by every thread ([`EnvironmentMap::partition`]).
 #[derive(Debug)]
 pub struct EnvironmentPartition {
-    layout: LatLong,
-    /// The map texel of every environment cell.
-    cell_texel: Vec<u32>,
-    /// Environment cells grouped by texel: texel `t` owns `cells[start[t]..start[t + 1]]`.
-    cells: Vec<u32>,
-    start: Vec<u32>,
-    /// For each entry of `cells`, the cumulative probability of the texel's cells up to and
-    /// including it, divided by the texel's total (so the last of each texel is 1).
-    within: Vec<f64>,
+    layout: GuideLayout,
+    contents: TexelContents,
     /// `P_t`: the environment's probability of each texel.
     texel_mass: Vec<f64>,
 }
 
 impl EnvironmentPartition {
-    /// Groups the cells of `environment` by the texels of `layout` (map directions are world
-    /// directions), each cell by the texel of its centre.
-    pub fn new(environment: &EnvironmentMap, layout: LatLong) -> Self {
+    /// Groups the cells of `environment` by the texels of `layout` (texel directions are
+    /// world directions), each cell by the texel of its centre.
+    pub fn new(environment: &EnvironmentMap, layout: GuideLayout) -> Self {
         let texels = layout.texel_count();
         let cell_texel: Vec<u32> = (0..environment.cell_count())
-            .map(|cell| layout.index(layout.texel(environment.cell_centre(cell))) as u32)
+            .map(|cell| layout.index(environment.cell_centre(cell)) as u32)
             .collect();
         let mut start = vec![0u32; texels + 1];
         for &t in &cell_texel {
@@ -53,42 +104,118 @@ impl EnvironmentPartition {
             cells[fill[t as usize] as usize] = cell as u32;
             fill[t as usize] += 1;
         }
-        let mut within = vec![0.0; cells.len()];
+        let mut within = Vec::with_capacity(texels);
         let mut texel_mass = vec![0.0; texels];
         for t in 0..texels {
             let range = start[t] as usize..start[t + 1] as usize;
-            let mut running = 0.0;
-            for i in range.clone() {
-                running += environment.cell_probability(cells[i] as usize);
-                within[i] = running;
-            }
-            texel_mass[t] = running;
-            if running > 0.0 {
-                within[range].iter_mut().for_each(|c| *c /= running);
-            }
+            let probabilities: Vec<f64> = cells[range]
+                .iter()
+                .map(|&cell| environment.cell_probability(cell as usize))
+                .collect();
+            texel_mass[t] = probabilities.iter().sum();
+            within.push(AliasTable::new(&probabilities));
         }
         EnvironmentPartition {
             layout,
-            cell_texel,
-            cells,
-            start,
-            within,
+            contents: TexelContents::Cells {
+                cell_texel,
+                cells,
+                start,
+                within,
+            },
             texel_mass,
         }
     }
 
-    /// The map layout the cells are grouped by.
-    pub fn layout(&self) -> LatLong {
+    /// Uniform directions (a constant environment) over `side × side` equal-area octahedral
+    /// texels, each of probability 1 / side².
+    pub fn uniform(side: u32) -> Self {
+        let layout = GuideLayout::Octahedral(side.clamp(1, 64));
+        let texels = layout.texel_count();
+        EnvironmentPartition {
+            layout,
+            contents: TexelContents::Uniform {
+                side: side.clamp(1, 64),
+            },
+            texel_mass: vec![1.0 / texels as f64; texels],
+        }
+    }
+
+    /// The layout the cells are grouped by.
+    pub fn layout(&self) -> GuideLayout {
         self.layout
     }
 
-    /// Bytes held by its tables (about 16 per environment cell).
+    /// `P_t`: the environment's sampling probability of texel `index`.
+    pub fn texel_mass(&self, index: usize) -> f64 {
+        self.texel_mass[index]
+    }
+
+    /// Bytes held by its tables (about 20 per environment cell).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(self)
-            + 4 * (self.cell_texel.len() + self.cells.len() + self.start.len())
-            + 8 * (self.within.len() + self.texel_mass.len())
+        let cells = match &self.contents {
+            TexelContents::Cells {
+                cell_texel,
+                cells,
+                start,
+                within,
+            } => {
+                4 * (cell_texel.len() + cells.len() + start.len())
+                    + 12 * cells.len()
+                    + std::mem::size_of::<AliasTable>() * within.len()
+            }
+            TexelContents::Uniform { .. } => 0,
+        };
+        std::mem::size_of_val(self) + cells + 8 * self.texel_mass.len()
+    }
+
+    /// A direction of texel `t` from `v` and `w` in [0, 1), in proportion to the
+    /// environment's own density there.
+    fn sample_in_texel(&self, environment: &Environment, t: usize, v: f32, w: f32) -> Toward {
+        match (&self.contents, environment) {
+            (
+                TexelContents::Cells {
+                    cells,
+                    start,
+                    within,
+                    ..
+                },
+                Environment::Map(map),
+            ) => {
+                let (i, fx) = within[t].sample(v);
+                let cell = cells[start[t] as usize + i] as usize;
+                map.toward_in_cell(cell, [fx, w.min(ONE_BELOW)])
+            }
+            (TexelContents::Uniform { side }, _) => {
+                let (row, column) = ((t as u32 / side) as f32, (t as u32 % side) as f32);
+                let square = [
+                    ((column + v) / *side as f32).min(ONE_BELOW),
+                    ((row + w) / *side as f32).min(ONE_BELOW),
+                ];
+                let direction = Vec3::from(octahedral::direction_of(square)).normalize();
+                Toward::from_environment(direction, None)
+            }
+            (TexelContents::Cells { .. }, _) => environment.sample_toward([v, w]),
+        }
+    }
+
+    /// The environment's own density at `toward` and the texel it lies in.
+    fn density_and_texel(&self, environment: &Environment, toward: &mut Toward) -> (f64, usize) {
+        match (&self.contents, environment) {
+            (TexelContents::Cells { cell_texel, .. }, Environment::Map(map)) => {
+                let (density, cell) = map.pdf_and_cell(toward);
+                (density as f64, cell_texel[cell] as usize)
+            }
+            _ => (
+                environment.pdf_toward(toward),
+                self.layout.index(toward.direction),
+            ),
+        }
     }
 }
+
+/// The largest f32 below 1.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// The partitions built for an environment, one per layout, shared by all threads. Cloning
 /// an environment starts an empty cache.
@@ -106,7 +233,7 @@ impl PartitionCache {
     pub(crate) fn get(
         &self,
         environment: &EnvironmentMap,
-        layout: LatLong,
+        layout: GuideLayout,
     ) -> Arc<EnvironmentPartition> {
         // A panic while building poisons nothing we rely on: the list stays valid.
         let mut built = self.0.lock().unwrap_or_else(|e| e.into_inner());
@@ -154,19 +281,19 @@ impl EnvironmentGuide {
         std::mem::size_of_val(self) + 4 * self.affinity.len() + 8 * self.cdf.len()
     }
 
-    /// The map layout the cells are grouped by.
-    pub fn layout(&self) -> LatLong {
+    /// The layout the cells are grouped by.
+    pub fn layout(&self) -> GuideLayout {
         self.partition.layout
     }
 
-    /// Sets the affinity `A_t` of every texel for the next batch. The product has density
+    /// Sets the affinity `A_t` of every texel (by index in the layout) for the next batch. The product has density
     /// only where `A_t > 0`: keep it positive wherever the integrand may be (non-positive or
     /// non-finite values count as 0; if no texel with environment mass is left, all count
     /// as 1).
-    pub fn set_affinities(&mut self, affinity: impl Fn(Texel) -> f32) {
+    pub fn set_affinities(&mut self, affinity: impl Fn(usize) -> f32) {
         let mut running = 0.0;
         for t in 0..self.affinity.len() {
-            let a = affinity(self.partition.layout.texel_of_index(t));
+            let a = affinity(t);
             self.affinity[t] = if a.is_finite() && a > 0.0 { a } else { 0.0 };
             running += self.affinity[t] as f64 * self.partition.texel_mass[t];
             self.cdf[t + 1] = running;
@@ -192,12 +319,12 @@ impl EnvironmentGuide {
     }
 
     /// A direction from the mixture for `u` ∈ [0, 1)², located on the map.
-    pub fn sample(&self, environment: &EnvironmentMap, u: [f32; 2]) -> Toward {
+    pub fn sample(&self, environment: &Environment, u: [f32; 2]) -> Toward {
         let beta = self.fraction;
         let u0 = u[0] as f64;
         if u0 >= beta {
             let rescaled = ((u0 - beta) / (1.0 - beta)).clamp(0.0, 1.0 - 1e-7);
-            return environment.sample([rescaled as f32, u[1]]);
+            return environment.sample_toward([rescaled as f32, u[1]]);
         }
         let u0 = u0 / beta;
         let texels = self.affinity.len();
@@ -206,25 +333,14 @@ impl EnvironmentGuide {
             t -= 1; // rounding at u ≈ 1: back to a texel with mass
         }
         let share = self.cdf[t + 1] - self.cdf[t];
-        let v = ((u0 - self.cdf[t]) / share).clamp(0.0, 1.0);
-        let partition = &*self.partition;
-        let range = partition.start[t] as usize..partition.start[t + 1] as usize;
-        let within = &partition.within[range.clone()];
-        let mut i = within.partition_point(|&c| c <= v).min(within.len() - 1);
-        while i > 0 && within[i] <= within[i - 1] {
-            i -= 1;
-        }
-        let below = if i == 0 { 0.0 } else { within[i - 1] };
-        let fx = ((v - below) / (within[i] - below)).clamp(0.0, 1.0 - 1e-7) as f32;
-        let cell = partition.cells[range.start + i] as usize;
-        environment.toward_in_cell(cell, [fx, u[1].min(1.0 - 1e-7)])
+        let v = ((u0 - self.cdf[t]) / share).clamp(0.0, 1.0) as f32;
+        self.partition.sample_in_texel(environment, t, v, u[1])
     }
 
     /// The mixture's density at a direction (solid angle).
-    pub fn pdf(&self, environment: &EnvironmentMap, toward: &mut Toward) -> f64 {
-        let (density, cell) = environment.pdf_and_cell(toward);
-        let product =
-            self.affinity[self.partition.cell_texel[cell] as usize] as f64 / self.normaliser;
-        density as f64 * ((1.0 - self.fraction) + self.fraction * product)
+    pub fn pdf(&self, environment: &Environment, toward: &mut Toward) -> f64 {
+        let (density, texel) = self.partition.density_and_texel(environment, toward);
+        let product = self.affinity[texel] as f64 / self.normaliser;
+        density * ((1.0 - self.fraction) + self.fraction * product)
     }
 }

@@ -15,7 +15,7 @@ mod toward;
 pub use area::{AreaHit, AreaLight, AreaSample, AreaShape, LightSpot};
 pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use environment::{luminance, Environment, EnvironmentMap};
-pub use environment_guide::{EnvironmentGuide, EnvironmentPartition};
+pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout};
 pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
 pub use spherical_rectangle::Rectangle;
@@ -139,10 +139,11 @@ impl Lights {
             let arrival = self.delta[delta].arrival(receiver.point)?;
             return Some(Toward::delta(delta, arrival));
         }
-        match (self.environment.as_ref()?, receiver.environment_guide) {
-            (Environment::Map(map), Some(guide)) => Some(guide.sample(map, [u0, u[1]])),
-            (environment, _) => Some(environment.sample_toward([u0, u[1]])),
-        }
+        let environment = self.environment.as_ref()?;
+        Some(match receiver.environment_guide {
+            Some(guide) => guide.sample(environment, [u0, u[1]]),
+            None => environment.sample_toward([u0, u[1]]),
+        })
     }
 
     /// [`Lights::sample_direction`] with its density over directions.
@@ -195,9 +196,9 @@ impl Lights {
         let Some(environment) = &self.environment else {
             return 0.0;
         };
-        let density = match (environment, receiver.environment_guide) {
-            (Environment::Map(map), Some(guide)) => guide.pdf(map, toward),
-            (environment, _) => environment.pdf_toward(toward),
+        let density = match receiver.environment_guide {
+            Some(guide) => guide.pdf(environment, toward),
+            None => environment.pdf_toward(toward),
         };
         self.choice_probability(self.environment_index()) * density
     }

@@ -127,7 +127,7 @@ impl Hasher for KeyHasher {
 type KeyMap<V> = HashMap<CellKey, V, BuildHasherDefault<KeyHasher>>;
 
 /// Where a cell's counts lie in a [`VisibilityField`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct CellIndex(u32);
 
 /// The learned field: every cell seen so far and its texels' counts.
@@ -416,6 +416,23 @@ impl FieldCell<'_> {
     #[inline]
     pub fn texel(&self, direction: [f32; 3]) -> TexelCounts {
         self.counts[octahedral::texel_of(direction, self.side)]
+    }
+
+    /// Texels per side of the cell's map.
+    pub fn side(&self) -> u32 {
+        self.side
+    }
+
+    /// The visibility of texel `index` (row-major, as [`octahedral::texel_of`] numbers
+    /// them) with the field's prior, or `None` where no ray of the cell went.
+    pub fn texel_visibility_at(&self, index: usize) -> Option<f32> {
+        let counts = *self.counts.get(index)?;
+        (counts.traced > 0).then(|| texel_visibility(counts, self.visibility(), self.prior))
+    }
+
+    /// The lowest visibility of the cell's texels.
+    pub fn darkest(&self) -> f32 {
+        self.darkest
     }
 
     /// The sum over the cell's texels.

@@ -4,7 +4,7 @@
 
 use super::guiding::CandidateSampler;
 use super::light::{free_radiance, Leaving, ShadowRay};
-use super::settings::{GatherSettings, MapUse};
+use super::settings::GatherSettings;
 use super::strategy::GatherPoint;
 use crate::lights::{luminance, Toward};
 use crate::render::RayCounts;
@@ -168,7 +168,7 @@ fn decide(
         });
         return (decision, Some(known));
     }
-    let decision = if run.settings.map_use == MapUse::Proposal {
+    let decision = if run.settings.map_use.guides() {
         // The map is already in the proposal: trace every candidate.
         batch.decide_with(direction, in_support, |_| 1.0)
     } else {

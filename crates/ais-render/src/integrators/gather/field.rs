@@ -169,7 +169,7 @@ pub(super) struct FieldSite<'a> {
     /// Its cell of the field.
     key: CellKey,
     /// The gather point.
-    at: &'a GatherPoint<'a>,
+    at: GatherPoint<'a>,
     /// The batch's scrambling seed.
     seed: u64,
     /// When a timed gather's pixel sample began (its camera ray and shading point count
@@ -182,7 +182,7 @@ impl<'a> FieldSite<'a> {
     /// in a cell `cell_pixels` footprints wide.
     pub fn new(
         hit: &Hit,
-        at: &'a GatherPoint<'a>,
+        at: GatherPoint<'a>,
         footprint: f32,
         cell_pixels: f32,
         seed: u64,
@@ -200,13 +200,13 @@ impl<'a> FieldSite<'a> {
     }
 }
 
-/// The cell `key` of `field`, remembering where it was in `last_cell`: neighbouring pixels
-/// often share a cell, and the field does not change within a pass.
+/// The cell `key` of `field` and where it is, remembering it in `last_cell`: neighbouring
+/// pixels often share a cell, and the field does not change within a pass.
 fn find_cell<'f>(
     field: &'f VisibilityField,
     last_cell: &mut Option<(CellKey, Option<CellIndex>)>,
     key: CellKey,
-) -> Option<FieldCell<'f>> {
+) -> Option<(CellIndex, FieldCell<'f>)> {
     let index = match *last_cell {
         Some((last, index)) if last == key => index,
         _ => {
@@ -215,17 +215,18 @@ fn find_cell<'f>(
             index
         }
     };
-    index.map(|index| field.cell_at(index))
+    index.map(|index| (index, field.cell_at(index)))
 }
 
-/// A gather with acceptance from the learned field: roulette where the field's cell says it
-/// pays at this render's cost ratio, every candidate traced (and no map work) elsewhere. Its
-/// traced rays are recorded for the next pass's field; one gather in [`TIMED_ONE_IN`] is
-/// timed for the next pass's cost ratio.
+/// A gather with the learned field: roulette where the field's cell says it pays at this
+/// render's cost ratio (`map_use` roulette or both), light sampling guided by the cell
+/// where it is worth it (`map_use` proposal or both), every candidate traced and no map
+/// work elsewhere. Its traced rays are recorded for the next pass's field; one gather in
+/// [`TIMED_ONE_IN`] is timed for the next pass's cost ratio.
 pub(super) fn field_gather<P: BatchProbe>(
     world: &World,
     settings: &GatherSettings,
-    site: &FieldSite,
+    site: FieldSite,
     state: &mut GatherTile<P>,
     counts: &mut RayCounts,
 ) -> Vec3 {
@@ -234,6 +235,8 @@ pub(super) fn field_gather<P: BatchProbe>(
         field,
         observations,
         field_gathers,
+        field_guided,
+        field_guides,
         last_cell,
         cost_ratio,
         cost,
@@ -243,10 +246,17 @@ pub(super) fn field_gather<P: BatchProbe>(
     } = state;
     let cost_ratio = *cost_ratio;
     let known = find_cell(field, last_cell, site.key);
-    let record = known.is_none_or(|cell| cell.total().traced < WELL_KNOWN)
+    let record = known.is_none_or(|(_, cell)| cell.total().traced < WELL_KNOWN)
         || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN);
-    let cell = known.filter(|cell| cell.worth_rolling(cost_ratio));
-    field_gathers[usize::from(cell.is_none())] += 1;
+    let rolling = known
+        .map(|(_, cell)| cell)
+        .filter(|cell| settings.map_use.rolls() && cell.worth_rolling(cost_ratio));
+    let mut at: GatherPoint<'_> = site.at;
+    if let (Some(guides), Some((index, cell))) = (field_guides.as_mut(), known) {
+        at.receiver.environment_guide = guides.guide(index, &cell);
+        *field_guided += u64::from(at.receiver.environment_guide.is_some());
+    }
+    field_gathers[usize::from(rolling.is_none())] += 1;
     *gathers += 1;
     let clock = Cell::new(Duration::ZERO);
     let timed = site.started.is_some();
@@ -254,11 +264,11 @@ pub(super) fn field_gather<P: BatchProbe>(
     let run = BatchRun {
         world,
         settings,
-        at: site.at,
+        at: &at,
         sampler: &sampler,
         seed: site.seed,
         start: MapStart::Empty,
-        field: cell.map(|cell| FieldUse { cell, cost_ratio }),
+        field: rolling.map(|cell| FieldUse { cell, cost_ratio }),
         clock: timed.then_some(&clock),
     };
     let batch = batch_for(batch, settings);

@@ -140,7 +140,7 @@ impl Guide {
         if let (true, Some(Environment::Map(environment))) =
             (samples_lights, &at.lights.environment)
         {
-            if self.environment.as_ref().map(EnvironmentGuide::layout) != Some(layout) {
+            if self.environment.as_ref().map(EnvironmentGuide::layout) != Some(layout.into()) {
                 self.environment = Some(EnvironmentGuide::new(environment.partition(layout)));
             }
             let guide = self.environment.as_mut().expect("just built");
@@ -149,7 +149,8 @@ impl Guide {
             // nothing there: give such texels the floor. Never 0, so the product keeps
             // density wherever light sampling alone had it (exactly unbiased).
             let floor = map.min_affinity(0).max(GUIDE_FLOOR);
-            guide.set_affinities(|texel| {
+            guide.set_affinities(|index| {
+                let texel = layout.texel_of_index(index);
                 let centre = layout.center_direction(texel);
                 if at.bsdf.in_support(at.wo, centre) {
                     map.texel_affinity(0, texel).max(floor)

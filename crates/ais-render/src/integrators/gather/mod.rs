@@ -8,11 +8,13 @@
 //! - [`learning_pass`]: maps learned around a tile before it renders (with the tile's
 //!   recent gathers of [`ais::shared`], the sources of shared maps);
 //! - [`guiding`]: a fixed map folded into the proposal;
-//! - [`field`]: acceptance from the visibility field learned between passes (`ais auto`).
+//! - [`field`]: acceptance from the visibility field learned between passes (`ais auto`);
+//! - [`field_guide`]: light sampling guided by that field.
 
 pub mod acceptance;
 pub mod batch_loop;
 pub mod field;
+pub mod field_guide;
 pub mod guiding;
 pub mod learning_pass;
 mod light;
@@ -33,6 +35,7 @@ use ais::field::{CellIndex, CellKey, FieldObservations, VisibilityField};
 use ais::rng::Pcg32;
 use ais::shared::{blend_neighbours, NeighbourSource, RecentGathers};
 use ais::{AffinityMap, Batch, MapStart};
+use field_guide::FieldGuides;
 use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
@@ -54,6 +57,8 @@ pub struct GatherStats {
     pub field_memory: usize,
     /// Gathers that used the field for roulette, and gathers where it stood aside.
     pub field_gathers: [u64; 2],
+    /// Gathers whose light sampling the field guided.
+    pub field_guided: u64,
     /// The cost ratio ρ (a candidate's work besides tracing, over tracing's) the field's
     /// acceptance used in the last pass.
     pub field_cost_ratio: f32,
@@ -67,6 +72,7 @@ impl TileStats for GatherStats {
         for (mine, theirs) in self.field_gathers.iter_mut().zip(other.field_gathers) {
             *mine += theirs;
         }
+        self.field_guided += other.field_guided;
         self.field_cost_ratio = self.field_cost_ratio.max(other.field_cost_ratio);
     }
 }
@@ -89,6 +95,11 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) observations: Option<FieldObservations>,
     /// Gathers that used the field, and gathers where it stood aside.
     pub(super) field_gathers: [u64; 2],
+    /// Gathers whose light sampling the field guided.
+    pub(super) field_guided: u64,
+    /// The environment guides of the field's cells this tile met (`map = field` guiding
+    /// light sampling).
+    pub(super) field_guides: Option<FieldGuides>,
     /// The last cell looked up in the field, and where it is: neighbouring pixels often
     /// share a cell.
     pub(super) last_cell: Option<(CellKey, Option<CellIndex>)>,
@@ -124,6 +135,16 @@ impl<P: BatchProbe> GatherTile<P> {
             observations: (field && tile.learns)
                 .then(|| FieldObservations::new(learning.field.side())),
             field_gathers: [0; 2],
+            field_guided: 0,
+            field_guides: (field && settings.map_use.guides()).then(|| {
+                let samples_lights = matches!(settings.strategy, Strategy::Light | Strategy::Mis);
+                FieldGuides::new(
+                    world,
+                    learning.field.side(),
+                    samples_lights,
+                    settings.guide_fraction,
+                )
+            }),
             last_cell: None,
             cost_ratio: learning.cost_ratio(),
             cost: CostSample::default(),
@@ -150,6 +171,10 @@ impl<P: BatchProbe> GatherTile<P> {
                 .observations
                 .as_ref()
                 .map_or(0, FieldObservations::memory_bytes)
+            + self
+                .field_guides
+                .as_ref()
+                .map_or(0, FieldGuides::memory_bytes)
     }
 
     /// The batches' counters so far.
@@ -186,6 +211,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
                 0
             },
             field_gathers: self.field_gathers,
+            field_guided: self.field_guided,
             field_cost_ratio: self.cost_ratio,
         }
     }
@@ -291,9 +317,9 @@ pub fn gather<P: BatchProbe>(
     let footprint = world.camera.footprint(hit.t, world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if settings.map == MapSource::Field {
-        let mut site = field::FieldSite::new(&hit, &at, footprint, settings.field_cell, seed);
+        let mut site = field::FieldSite::new(&hit, at, footprint, settings.field_cell, seed);
         site.started = started;
-        return emitted + field::field_gather(world, settings, &site, state, counts);
+        return emitted + field::field_gather(world, settings, site, state, counts);
     }
     let site = MapSite {
         hit: &hit,
@@ -337,7 +363,7 @@ fn map_gather<P: BatchProbe>(
             footprint: site.footprint,
         };
         let found = neighbourhood.blend_into(map, site.hit.point, at.frame.normal);
-        if settings.map_use == MapUse::Proposal && found > 0 {
+        if settings.map_use.guides() && found > 0 {
             let guide = state
                 .guide
                 .get_or_insert_with(|| Guide::new(settings.map_height));

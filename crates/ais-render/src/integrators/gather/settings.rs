@@ -10,12 +10,12 @@
 //! | `ais` | string | `off` | a preset of the three map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided`, `auto` |
 //! | `map` | string | `none` | where a batch's affinity map starts: `none` (AIS off), `batch` (empty, learned from the batch's own rays: the talk's), `neighbours` (blended from neighbouring gathers, see `sharing`), `field` (the visibility field learned in earlier passes over the whole image) |
 //! | `update` | string | `off` | how the batch learns from its own rays, in frozen-map epochs: `off`, `aggressive`, `conservative` (the talk's shadow-edge resets) |
-//! | `map_use` | string | `roulette` | how the map is used: `roulette` (skip probably blocked candidates, weight 1/a) or `proposal` (fold the map into the proposal, reject nothing) |
+//! | `map_use` | string | `roulette` | how the map is used: `roulette` (skip probably blocked candidates, weight 1/a), `proposal` (fold the map into the proposal, reject nothing; with `map = field`, light sampling draws the environment through the field), or `both` (`map = field` only) |
 //! | `acceptance` | string | `affinity` | roulette's acceptance: `affinity` (the talk's), `sqrt`, `value`, `efficient` |
 //! | `sharing` | string | `tile` | where `neighbours` maps come from: `tile` (the gathers before it in its tile) or `pass` / `pass:S` (a learning pass over S×S pixel blocks, S in 1..=16; default 4) |
 //! | `tol` | float | 1 | the map's floor, a_min = 1/(tol·h²); `inf` for none |
 //! | `map_res` | integer | 4 | the map's height h in texels (width 2h), 1 to 1024 |
-//! | `guide_fraction` | float | 0.5 | `map_use = proposal`: the guide's share of the proposal, in [0, 0.99] |
+//! | `guide_fraction` | float | 0.5 | `map_use = proposal` or `both`: the guide's share of the proposal (of light sampling's environment draws, with the field), in [0, 0.99] |
 //! | `field_res` | integer | 8 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
 //! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
@@ -94,8 +94,23 @@ pub enum MapUse {
     /// Russian roulette: a candidate is traced with its acceptance probability and weighs
     /// its inverse.
     Roulette,
-    /// Folded into the proposal (see [`super::guiding`]): nothing is rejected.
+    /// Folded into the proposal (see [`super::guiding`], and [`super::field_guide`] for
+    /// the field): nothing is rejected.
     Proposal,
+    /// The field's two uses at once: light sampling guided by it, and roulette.
+    Both,
+}
+
+impl MapUse {
+    /// Whether candidates are rolled.
+    pub fn rolls(self) -> bool {
+        matches!(self, MapUse::Roulette | MapUse::Both)
+    }
+
+    /// Whether the map shapes the proposal.
+    pub fn guides(self) -> bool {
+        matches!(self, MapUse::Proposal | MapUse::Both)
+    }
 }
 
 /// A named bundle of [`MapSource`], [`Update`] and [`MapUse`].
@@ -351,6 +366,7 @@ impl Choice for MapUse {
     const WORDS: &'static [(&'static str, Self)] = &[
         ("roulette", MapUse::Roulette),
         ("proposal", MapUse::Proposal),
+        ("both", MapUse::Both),
     ];
 }
 
@@ -558,14 +574,13 @@ impl GatherSettings {
             (MapSource::None, _, _) => {
                 Err("map none (AIS off) takes neither an update nor map_use proposal".into())
             }
-            (MapSource::Field, Update::Off, MapUse::Roulette)
-                if self.acceptance == Acceptance::Affinity =>
-            {
-                Ok(())
+            (MapSource::Field, Update::Off, _) if self.acceptance == Acceptance::Affinity => Ok(()),
+            (MapSource::Field, _, _) => {
+                Err("map field (auto) chooses its own acceptance and takes no update rule".into())
             }
-            (MapSource::Field, _, _) => Err(
-                "map field (auto) chooses its own acceptance and takes no update or map_use".into(),
-            ),
+            (_, _, MapUse::Both) => {
+                Err("map_use both needs the visibility field (map field)".into())
+            }
             (MapSource::Batch, Update::Off, _) => {
                 Err("a per-batch map (map batch) needs an update rule to learn with".into())
             }
