@@ -311,6 +311,12 @@ impl EnvironmentGuide {
         *self.cdf.last_mut().expect("at least one texel") = 1.0;
     }
 
+    /// How much more often the mixture draws texel `t` than the environment alone:
+    /// `(1 − β) + β A_t / Z`.
+    pub fn mixture_weight(&self, t: usize) -> f64 {
+        (1.0 - self.fraction) + self.fraction * self.affinity[t] as f64 / self.normaliser
+    }
+
     /// Sets the product's share β ∈ [0, 1] of the mixture with the environment's own
     /// distribution (1: the product alone). A map that wrongly calls a bright light blocked
     /// raises the variance by at most 1 / (1 − β).
@@ -340,7 +346,6 @@ impl EnvironmentGuide {
     /// The mixture's density at a direction (solid angle).
     pub fn pdf(&self, environment: &Environment, toward: &mut Toward) -> f64 {
         let (density, texel) = self.partition.density_and_texel(environment, toward);
-        let product = self.affinity[texel] as f64 / self.normaliser;
-        density * ((1.0 - self.fraction) + self.fraction * product)
+        density * self.mixture_weight(texel)
     }
 }

@@ -142,7 +142,7 @@ impl<P: BatchProbe> GatherTile<P> {
                     world,
                     learning.field.side(),
                     samples_lights,
-                    settings.guide_fraction,
+                    settings.guide_share(),
                 )
             }),
             last_cell: None,
@@ -259,14 +259,14 @@ fn guided_sampler<'g>(
     settings: &GatherSettings,
     at: &mut GatherPoint<'g>,
 ) -> CandidateSampler<'g> {
-    match guide.prepare(map, settings.strategy, at, settings.guide_fraction) {
+    match guide.prepare(map, settings.strategy, at, settings.guide_share()) {
         Guidance::Unguided => CandidateSampler::plain(settings.strategy),
         Guidance::Environment(environment) => {
             at.receiver.environment_guide = Some(environment);
             CandidateSampler::plain(settings.strategy)
         }
         Guidance::Mixture(distribution) => {
-            CandidateSampler::guided(settings.strategy, distribution, settings.guide_fraction)
+            CandidateSampler::guided(settings.strategy, distribution, settings.guide_share())
         }
     }
 }

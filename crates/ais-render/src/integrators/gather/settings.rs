@@ -15,7 +15,7 @@
 //! | `sharing` | string | `tile` | where `neighbours` maps come from: `tile` (the gathers before it in its tile) or `pass` / `pass:S` (a learning pass over S×S pixel blocks, S in 1..=16; default 4) |
 //! | `tol` | float | 1 | the map's floor, a_min = 1/(tol·h²); `inf` for none |
 //! | `map_res` | integer | 4 | the map's height h in texels (width 2h), 1 to 1024 |
-//! | `guide_fraction` | float | 0.5 | `map_use = proposal` or `both`: the guide's share of the proposal (of light sampling's environment draws, with the field), in [0, 0.99] |
+//! | `guide_fraction` | float | 0.5; 0.75 with `map = field` | `map_use = proposal` or `both`: the guide's share of the proposal (of light sampling's environment draws, with the field), in [0, 0.99] |
 //! | `field_res` | integer | 8 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
 //! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
@@ -24,7 +24,7 @@
 //!
 //! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
 //! `update`; `shared` = `map neighbours`; `warm` = `map neighbours, update aggressive`;
-//! `guided` = `map neighbours, map_use proposal`; `auto` = `map field`. A preset sets `map`, `update` and
+//! `guided` = `map neighbours, map_use proposal`; `auto` = `map field, map_use both`. A preset sets `map`, `update` and
 //! `map_use`; the other parameters keep their values, and any given alongside it apply after
 //! it.
 
@@ -163,7 +163,7 @@ impl Preset {
             Preset::Shared => (S::Neighbours, Update::Off, MapUse::Roulette),
             Preset::Warm => (S::Neighbours, Update::Aggressive, MapUse::Roulette),
             Preset::Guided => (S::Neighbours, Update::Off, MapUse::Proposal),
-            Preset::Auto => (S::Field, Update::Off, MapUse::Roulette),
+            Preset::Auto => (S::Field, Update::Off, MapUse::Both),
         }
     }
 }
@@ -251,8 +251,9 @@ pub struct GatherSettings {
     pub tol: f32,
     /// The map's height in texels.
     pub map_height: u32,
-    /// `map_use = proposal`: the guide's share α of the proposal mixture `(1 − α) p + α g`.
-    pub guide_fraction: f32,
+    /// `map_use = proposal` or `both`: the guide's share α of the proposal mixture
+    /// `(1 − α) p + α g`; `None`: the default for the map ([`GatherSettings::guide_share`]).
+    pub guide_fraction: Option<f32>,
     /// `map = field`: the cost ratio ρ (a candidate's work besides tracing, over what
     /// tracing it adds) its acceptance uses; `None`: measured in the render.
     pub cost_ratio: Option<f32>,
@@ -288,7 +289,7 @@ impl Default for GatherSettings {
             sharing: Sharing::TileOrder,
             tol: map.tol,
             map_height: map.height,
-            guide_fraction: super::guiding::GUIDE_FRACTION,
+            guide_fraction: None,
             cost_ratio: None,
             field_res: ais::field::DEFAULT_SIDE,
             field_cell: 4.0,
@@ -449,7 +450,7 @@ impl GatherSettings {
             }
             "tol" => self.tol = number(value, "tol")?,
             "map_res" => self.map_height = number(value, "map_res")?,
-            "guide_fraction" => self.guide_fraction = number(value, "guide_fraction")?,
+            "guide_fraction" => self.guide_fraction = Some(number(value, "guide_fraction")?),
             "hide_emitters" => {
                 self.hide_emitters = match value {
                     "true" => true,
@@ -548,7 +549,7 @@ impl GatherSettings {
         if !(1..=LARGEST_MAP_RES).contains(&self.map_height) {
             return Err(format!("map_res must lie in 1..={LARGEST_MAP_RES}"));
         }
-        if !(0.0..=0.99).contains(&self.guide_fraction) {
+        if !(0.0..=0.99).contains(&self.guide_share()) {
             return Err("guide_fraction must lie in [0, 0.99]".into());
         }
         if !(1..=64).contains(&self.field_res) {
@@ -597,6 +598,15 @@ impl GatherSettings {
             }
             _ => Ok(()),
         }
+    }
+
+    /// The guide's share of the proposal: as given, else [`super::guiding::GUIDE_FRACTION`]
+    /// for a neighbours' map and [`super::field_guide::FIELD_GUIDE_FRACTION`] for the field.
+    pub fn guide_share(&self) -> f32 {
+        self.guide_fraction.unwrap_or(match self.map {
+            MapSource::Field => super::field_guide::FIELD_GUIDE_FRACTION,
+            _ => super::guiding::GUIDE_FRACTION,
+        })
     }
 
     /// Whether each gather starts from maps learned at neighbouring gather points.
