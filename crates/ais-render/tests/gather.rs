@@ -397,12 +397,12 @@ fn small_shipped_scene(name: &str) -> World {
 }
 
 #[test]
-fn light_sampling_guided_by_the_field_is_unbiased() {
-    // The field learned in each render's first passes guides the environment's draws in the
-    // later ones (alone, and together with roulette), through a window: every pixel agrees
-    // with AIS off. The interior's sky is an environment map; the overcast room's a
-    // constant.
+fn the_field_is_unbiased_in_rooms_lit_through_windows() {
+    // The field learned in each render's first passes rolls the later ones' candidates,
+    // guides their environment draws, or both, through a window: every pixel agrees with
+    // AIS off. The interior's sky is an environment map; the overcast room's a constant.
     let cases = [
+        ("interior.xml", Strategy::Mis, MapUse::Roulette),
         ("interior.xml", Strategy::Mis, MapUse::Proposal),
         ("interior.xml", Strategy::Light, MapUse::Proposal),
         ("interior.xml", Strategy::Mis, MapUse::Both),
@@ -424,10 +424,10 @@ fn light_sampling_guided_by_the_field_is_unbiased() {
             crop: None,
         };
         let output = render(&world, &Integrator::Gather(gather), &settings);
-        assert!(
-            output.stats.field_guided > 0,
-            "the field guides some gathers"
-        );
+        let guided = output.stats.field_guided > 0;
+        assert_eq!(guided, map_use.guides(), "{scene} {map_use:?}: guided");
+        let rolled = output.stats.ais.rejected_roulette > 0;
+        assert_eq!(rolled, map_use.rolls(), "{scene} {map_use:?}: rolled");
         let statistics = pixel_statistics(&world, gather, 8, 48);
         if let Err(message) = agreement(&statistics, &reference) {
             panic!("{scene} {strategy:?} {map_use:?}: {message}");

@@ -39,6 +39,14 @@ pub fn field_passes(spp: u32) -> Vec<u32> {
     passes
 }
 
+/// The field's roulette runs only in gathers of at least this many candidates. Measured
+/// on ten scenes (the repository's BENCHMARKS.md, section 5.6): with 16 candidates it never
+/// gained at equal time and lost up to 23% (a room lit through a door gap), with 128 it
+/// gains in closed rooms. Skipping a few rays of a small gather saves little next to what
+/// the gather costs anyway (its camera ray, its shading point, its share of the passes),
+/// while every skip adds variance.
+pub const LEAST_ROLLING_RAYS: u32 = 64;
+
 /// Learning stops once fewer than this share of the rays fall in cells where roulette pays.
 pub const LEAST_ROLLING_SHARE: f32 = 0.05;
 
@@ -248,9 +256,10 @@ pub(super) fn field_gather<P: BatchProbe>(
     let known = find_cell(field, last_cell, site.key);
     let record = known.is_none_or(|(_, cell)| cell.total().traced < WELL_KNOWN)
         || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN);
+    let rolls = settings.map_use.rolls() && settings.rays >= LEAST_ROLLING_RAYS;
     let rolling = known
         .map(|(_, cell)| cell)
-        .filter(|cell| settings.map_use.rolls() && cell.worth_rolling(cost_ratio));
+        .filter(|cell| rolls && cell.worth_rolling(cost_ratio));
     let mut at: GatherPoint<'_> = site.at;
     if let (Some(guides), Some((index, cell))) = (field_guides.as_mut(), known) {
         at.receiver.environment_guide = guides.guide(index, &cell);
