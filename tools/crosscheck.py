@@ -9,7 +9,7 @@
 Each scene is rendered by Mitsuba's `direct` integrator (scalar_rgb; `--mitsuba-samples`
 emitter and BSDF samples per camera sample; the scene's own reconstruction filter, Mitsuba's
 Gaussian when it names none, as ais reads it) and by
-`ais render` (gather, MIS, once per `--modes` entry: AIS off and per-batch AIS by default),
+`ais render` (gather, MIS, once per `--modes` entry: AIS off and `auto`, the default, by default),
 at the same resolution. Each renderer runs `--runs` times with independent seeds, and the
 spread of those runs gives a per-pixel standard error (SE) for both images. Reported per
 scene and ais mode:
@@ -349,7 +349,7 @@ def main():
     parser.add_argument("--rays", type=int, default=16, help="ais gather rays per camera sample")
     parser.add_argument("--mitsuba-samples", type=int, default=8,
                         help="Mitsuba direct: emitter and BSDF samples per camera sample")
-    parser.add_argument("--modes", default="off,aggressive", help="ais --ais modes to check")
+    parser.add_argument("--modes", default="off,auto", help="ais --ais modes to check")
     parser.add_argument("--ais", default=os.path.join(ROOT, "target", "release", "ais"),
                         help="the ais binary")
     parser.add_argument("--out", default=os.path.join(ROOT, "target", "crosscheck"),

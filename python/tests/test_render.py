@@ -37,7 +37,7 @@ def test_render_returns_an_image_array(cornell):
 def test_stats_come_with_the_image(cornell):
     image, stats = ais.render(cornell, stats=True, **SMALL)
     assert image.shape == (32, 48, 3)
-    assert stats["spp"] == 2 and stats["rays"] == 8 and stats["ais"] == "off"
+    assert stats["spp"] == 2 and stats["rays"] == 8 and stats["ais"] == "auto"
     assert stats["camera_rays"] == 48 * 32 * 2
     assert stats["candidates_per_gather"] == pytest.approx(8.0)
     assert 0 < stats["traced_per_gather"] <= 8

@@ -4,7 +4,8 @@ use crate::gather_flags::GatherFlags;
 use crate::{load_world, parse_resolution, start_threads, SceneFlags, SceneRequest, ThreadFlags};
 use ais_render::atomic_write::OutputSet;
 use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
-use ais_render::integrators::gather::GatherStats;
+use ais_render::integrators::gather::field::LEAST_ROLLING_RAYS;
+use ais_render::integrators::gather::{GatherStats, MapSource};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
 use ais_render::render::{render, PixelRect, RenderOutput, RenderSettings};
 use ais_render::world::World;
@@ -360,6 +361,11 @@ fn print_gather_summary(
         rendered.output.stats.memory_per_thread as f64 / 1024.0
     );
     let [rolled, aside] = rendered.output.stats.field_gathers;
+    if settings.map == MapSource::Field && rolled + aside == 0 {
+        println!(
+            "field        not used: no environment to guide, and roulette needs {LEAST_ROLLING_RAYS} rays per gather (rendered as AIS off)"
+        );
+    }
     if rolled + aside > 0 {
         println!(
             "field        {:.1} KiB; roulette in {:.1}% of gathers, stood aside in the rest; light sampling guided in {:.1}%; cost ratio {:.2}",

@@ -6,7 +6,7 @@
 use crate::errors::argument_error;
 use crate::options::parameter_text;
 use ais::{BatchConfig, BatchSet, Round};
-use ais_render::integrators::gather::{GatherSettings, MapSource};
+use ais_render::integrators::gather::{GatherSettings, MapSource, Preset};
 use numpy::ndarray::{Array1, Array2, ArrayView2};
 use numpy::{IntoPyArray, PyReadonlyArray1, PyReadonlyArray2};
 use pyo3::prelude::*;
@@ -38,7 +38,8 @@ struct Chunk {
 
 /// The library configuration from `ais=…` and the other batch parameters.
 fn batch_config(options: Option<&Bound<'_, PyDict>>) -> PyResult<BatchConfig> {
-    let mut settings = GatherSettings::default();
+    // A batch set learns within each gather: AIS off unless asked.
+    let mut settings = GatherSettings::preset(Preset::Off);
     if let Some(options) = options {
         for (key, value) in options.iter() {
             let name: String = key.extract()?;

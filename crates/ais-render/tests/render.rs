@@ -154,15 +154,21 @@ fn crops_pasted_together_equal_the_whole_render() {
     }
 }
 
+/// scenes/interior.xml (a room lit through a window by a sky with a sun) at `width × height`.
+fn interior(width: u32, height: u32) -> World {
+    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
+    let mut world =
+        World::from_description(load_scene(&scenes.join("interior.xml"), &[]).unwrap()).unwrap();
+    world.set_resolution((width, height));
+    world
+}
+
 #[test]
 fn the_learned_field_is_thread_independent_and_used() {
     // Two passes of 1 spp: the field learned in the first is fixed for the second, and
     // merged from integer counts, so the image cannot depend on the threads. A room lit
     // through a window, with many rays per gather: where roulette pays.
-    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
-    let mut world =
-        World::from_description(load_scene(&scenes.join("interior.xml"), &[]).unwrap()).unwrap();
-    world.set_resolution((48, 27));
+    let world = interior(48, 27);
     // The measured cost ratio depends on timing; pinned, the image is reproducible. A low
     // ratio (rays dear next to the rest of a candidate's work) makes roulette pay in some
     // cells. With `map_use = both` the field also guides light sampling.
@@ -187,6 +193,27 @@ fn the_learned_field_is_thread_independent_and_used() {
         assert!(one.stats.field_memory > 0);
         assert_eq!(one.stats.field_guided > 0, map_use == MapUse::Both);
     }
+}
+
+#[test]
+fn the_default_gather_guides_without_timing_and_is_reproducible() {
+    // The default (auto, 16 candidates, the cost ratio measured) neither rolls nor times
+    // anything: its image is the same at any thread count and in every run.
+    let world = interior(48, 27);
+    let auto = Integrator::Gather(GatherSettings::default());
+    let one = on_threads(&world, 1, auto);
+    let two = on_threads(&world, 2, auto);
+    let again = on_threads(&world, 2, auto);
+    assert_eq!(bits(&one.image), bits(&two.image));
+    assert_eq!(bits(&two.image), bits(&again.image));
+    assert!(
+        one.stats.field_guided > 0,
+        "the field guides light sampling"
+    );
+    assert_eq!(
+        one.stats.ais.rejected_roulette, 0,
+        "nothing is rolled at n = 16"
+    );
 }
 
 #[test]
@@ -393,7 +420,8 @@ fn the_exported_default_scene_renders_as_the_built_in_one() {
         exported.geometry.triangle_count(),
         built_in.geometry.triangle_count()
     );
-    let integrator = Integrator::Gather(GatherSettings::default());
+    // AIS off: the field's cells would follow the rounding of positions through the files.
+    let integrator = Integrator::Gather(GatherSettings::preset(Preset::Off));
     let (a, b) = (
         render_with(&exported, integrator, 2).image,
         render_with(&built_in, integrator, 2).image,

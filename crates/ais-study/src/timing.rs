@@ -162,8 +162,8 @@ impl SampleIntegrator for TimedGather {
     type Learned = GatherLearning;
     type Tile = TimedTile;
 
-    fn passes(&self, spp: u32) -> Vec<u32> {
-        Integrator::Gather(self.0).passes(spp)
+    fn passes(&self, world: &World, spp: u32) -> Vec<u32> {
+        Integrator::Gather(self.0).passes(world, spp)
     }
 
     fn new_learning(&self) -> GatherLearning {

@@ -5,7 +5,7 @@
 #[path = "../../ais-render/tests/common/mod.rs"]
 mod common;
 
-use ais_render::integrators::gather::{GatherSettings, Strategy};
+use ais_render::integrators::gather::{GatherSettings, Preset, Strategy};
 use ais_render::integrators::Integrator;
 use ais_study::oracle::Oracle;
 use common::{agreement, pixel_statistics};
@@ -21,7 +21,7 @@ fn oracle(strategy: Strategy) -> Oracle {
     Oracle(GatherSettings {
         strategy,
         rays: 16,
-        ..GatherSettings::default()
+        ..GatherSettings::preset(Preset::Off)
     })
 }
 
@@ -52,7 +52,7 @@ fn the_oracle_agrees_with_the_reference_in_an_occluded_scene() {
     let world = common::occluded_scene();
     let reference_settings = GatherSettings {
         rays: 32,
-        ..GatherSettings::default()
+        ..GatherSettings::preset(Preset::Off)
     };
     let reference = pixel_statistics(&world, &Integrator::Gather(reference_settings), 64, 8);
     for strategy in STRATEGIES {

@@ -12,7 +12,7 @@ use crate::render::{RayCounts, SampleIntegrator, Tile, TileState};
 use crate::world::World;
 use ais::rng::Pcg32;
 use gather::FieldPass;
-use gather::{GatherLearning, GatherSettings, GatherStats, GatherTile, MapSource};
+use gather::{GatherLearning, GatherSettings, GatherStats, GatherTile};
 
 /// What to compute at each camera sample.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,9 +64,9 @@ impl SampleIntegrator for Integrator {
     type Learned = GatherLearning;
     type Tile = IntegratorTile;
 
-    fn passes(&self, spp: u32) -> Vec<u32> {
+    fn passes(&self, world: &World, spp: u32) -> Vec<u32> {
         match self {
-            Integrator::Gather(settings) if settings.map == MapSource::Field => {
+            Integrator::Gather(settings) if gather::field_has_use(world, settings) => {
                 gather::field_passes(spp)
             }
             _ => vec![spp],

@@ -78,8 +78,8 @@ pub trait SampleIntegrator: Sync {
     /// Per-tile state.
     type Tile: TileState;
 
-    /// How `spp` samples per pixel split into passes (one pass unless it learns).
-    fn passes(&self, spp: u32) -> Vec<u32> {
+    /// How `spp` samples per pixel split into passes in `world` (one pass unless it learns).
+    fn passes(&self, _world: &World, spp: u32) -> Vec<u32> {
         vec![spp]
     }
 

@@ -162,7 +162,7 @@ fn render_passes<I: SampleIntegrator>(
     // A filter wider than a pixel needs the samples of the pixels around the region too.
     let rendered = region.grown(world.filter.margin(), (width, height));
     let rects = tiles_of(rendered, (width, height));
-    let mut passes = integrator.passes(settings.samples_per_pixel);
+    let mut passes = integrator.passes(world, settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
     let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(region, rendered);

@@ -4,8 +4,8 @@
 
 use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse};
 use super::guiding::CandidateSampler;
-use super::strategy::GatherPoint;
-use super::{batch_for, GatherSettings, GatherTile};
+use super::strategy::{GatherPoint, Strategy};
+use super::{batch_for, GatherSettings, GatherTile, MapSource};
 use crate::geometry::Hit;
 use crate::render::{Learning, RayCounts};
 use crate::world::World;
@@ -46,6 +46,24 @@ pub fn field_passes(spp: u32) -> Vec<u32> {
 /// the gather costs anyway (its camera ray, its shading point, its share of the passes),
 /// while every skip adds variance.
 pub const LEAST_ROLLING_RAYS: u32 = 64;
+
+/// Whether gathers with these settings use the field's roulette: `map_use` roulette or
+/// both, and at least [`LEAST_ROLLING_RAYS`] candidates. Only then is the cost ratio
+/// measured (and timing can change an image).
+pub fn field_rolls(settings: &GatherSettings) -> bool {
+    settings.map_use.rolls() && settings.rays >= LEAST_ROLLING_RAYS
+}
+
+/// Whether the field can change anything in `world` with these settings (`map = field`):
+/// its roulette runs ([`field_rolls`]), or it can guide light sampling toward an
+/// environment. Elsewhere (area lights only, and fewer than [`LEAST_ROLLING_RAYS`]
+/// candidates) the gather renders as AIS off: one pass, nothing recorded or timed.
+pub fn field_has_use(world: &World, settings: &GatherSettings) -> bool {
+    let guides = settings.map_use.guides()
+        && world.lights.environment.is_some()
+        && matches!(settings.strategy, Strategy::Light | Strategy::Mis);
+    settings.map == MapSource::Field && (field_rolls(settings) || guides)
+}
 
 /// Learning stops once fewer than this share of the rays fall in cells where roulette pays.
 pub const LEAST_ROLLING_SHARE: f32 = 0.05;
@@ -113,6 +131,8 @@ pub struct GatherLearning {
     pub cost: CostSample,
     /// The settings' `cost_ratio`, if pinned.
     pinned_cost_ratio: Option<f32>,
+    /// Whether the gathers roll ([`field_rolls`]).
+    rolls: bool,
 }
 
 impl GatherLearning {
@@ -123,6 +143,7 @@ impl GatherLearning {
             field: Arc::new(field),
             cost: CostSample::default(),
             pinned_cost_ratio: settings.cost_ratio,
+            rolls: field_rolls(settings),
         }
     }
 
@@ -152,23 +173,28 @@ impl Learning for GatherLearning {
         Arc::make_mut(&mut self.field).plan(cost_ratio);
     }
 
-    /// Learning goes on unless the field, with enough evidence, stands aside for nearly
-    /// every ray (the talk's auto-disable): then the rest of the render is one pass.
+    /// Learning goes on unless the field's roulette, with enough evidence, stands aside
+    /// for nearly every ray (the talk's auto-disable): then the rest of the render is one
+    /// pass. Gathers that do not roll learn for the guides on the full schedule, whatever
+    /// the timings: their images do not depend on the machine.
     fn keeps_learning(&self) -> bool {
-        self.field
-            .rolling_share()
-            .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
+        !self.rolls
+            || self
+                .field
+                .rolling_share()
+                .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
     }
 }
 
 /// Whether the tile's next field gather is one of the timed ones (one in
-/// [`TIMED_ONE_IN`], while learning with a measured cost ratio).
+/// [`TIMED_ONE_IN`], while learning with a measured cost ratio for roulette).
 pub(super) fn times_next_gather<P: BatchProbe>(
     state: &GatherTile<P>,
     settings: &GatherSettings,
 ) -> bool {
     state.observations.is_some()
         && settings.cost_ratio.is_none()
+        && field_rolls(settings)
         && (state.gathers + 1).is_multiple_of(TIMED_ONE_IN)
 }
 
@@ -256,7 +282,7 @@ pub(super) fn field_gather<P: BatchProbe>(
     let known = find_cell(field, last_cell, site.key);
     let record = known.is_none_or(|(_, cell)| cell.total().traced < WELL_KNOWN)
         || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN);
-    let rolls = settings.map_use.rolls() && settings.rays >= LEAST_ROLLING_RAYS;
+    let rolls = field_rolls(settings);
     let rolling = known
         .map(|(_, cell)| cell)
         .filter(|cell| rolls && cell.worth_rolling(cost_ratio));

@@ -23,7 +23,7 @@ pub mod strategy;
 
 pub use acceptance::Acceptance;
 pub use batch_loop::{run_batch, BatchProbe, BatchRun};
-pub use field::{field_passes, CostSample, FieldPass, GatherLearning};
+pub use field::{field_has_use, field_passes, CostSample, FieldPass, GatherLearning};
 pub use light::arriving_light;
 pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing, Update};
 pub use strategy::{gather_point, GatherPoint, Strategy};
@@ -294,8 +294,9 @@ pub fn gather<P: BatchProbe>(
     state: &mut GatherTile<P>,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    let started = (settings.map == MapSource::Field && field::times_next_gather(state, settings))
-        .then(std::time::Instant::now);
+    let field = field::field_has_use(world, settings);
+    let started =
+        (field && field::times_next_gather(state, settings)).then(std::time::Instant::now);
     counts.closest_hit += 1;
     let Some(hit) = world.geometry.intersect(ray) else {
         if settings.hide_emitters {
@@ -316,7 +317,7 @@ pub fn gather<P: BatchProbe>(
     let at = gather_point(world, &hit, -ray.direction);
     let footprint = world.camera.footprint(hit.t, world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
-    if settings.map == MapSource::Field {
+    if field {
         let mut site = field::FieldSite::new(&hit, at, footprint, settings.field_cell, seed);
         site.started = started;
         return emitted + field::field_gather(world, settings, site, state, counts);

@@ -7,10 +7,10 @@
 //! | `rays` | integer | 16 | candidates per gather, n (1 to 1,048,576) |
 //! | `budget` | string | `candidates` | what `rays` counts: `candidates` (AIS traces only the accepted ones) or `traced` (AIS draws extra candidates to trace about n) |
 //! | `placement` | string | `halton` | candidate placement: `halton` (scrambled per batch) or `random` |
-//! | `ais` | string | `off` | a preset of the three map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided`, `auto` |
-//! | `map` | string | `none` | where a batch's affinity map starts: `none` (AIS off), `batch` (empty, learned from the batch's own rays: the talk's), `neighbours` (blended from neighbouring gathers, see `sharing`), `field` (the visibility field learned in earlier passes over the whole image) |
+//! | `ais` | string | `auto` | a preset of the three map settings below: `off`, `aggressive`, `conservative`, `shared`, `warm`, `guided`, `auto` |
+//! | `map` | string | `field` | where a batch's affinity map starts: `none` (AIS off), `batch` (empty, learned from the batch's own rays: the talk's), `neighbours` (blended from neighbouring gathers, see `sharing`), `field` (the visibility field learned in earlier passes over the whole image) |
 //! | `update` | string | `off` | how the batch learns from its own rays, in frozen-map epochs: `off`, `aggressive`, `conservative` (the talk's shadow-edge resets) |
-//! | `map_use` | string | `roulette` | how the map is used: `roulette` (skip probably blocked candidates, weight 1/a), `proposal` (fold the map into the proposal, reject nothing; with `map = field`, light sampling draws the environment through the field), or `both` (`map = field` only) |
+//! | `map_use` | string | `both` | how the map is used: `roulette` (skip probably blocked candidates, weight 1/a), `proposal` (fold the map into the proposal, reject nothing; with `map = field`, light sampling draws the environment through the field), or `both` (`map = field` only) |
 //! | `acceptance` | string | `affinity` | roulette's acceptance: `affinity` (the talk's), `sqrt`, `value`, `efficient` |
 //! | `sharing` | string | `tile` | where `neighbours` maps come from: `tile` (the gathers before it in its tile) or `pass` / `pass:S` (a learning pass over S×S pixel blocks, S in 1..=16; default 4) |
 //! | `tol` | float | 1 | the map's floor, a_min = 1/(tol·h²); `inf` for none |
@@ -20,7 +20,7 @@
 //! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
-//! | `cost_ratio` | float or `measured` | `measured` | `map = field`: ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass but the last unless given (give it to make an image reproducible bit for bit) |
+//! | `cost_ratio` | float or `measured` | `measured` | `map = field` with roulette (64 or more candidates): ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass but the last unless given (give it to make such an image reproducible bit for bit; with fewer candidates nothing is timed) |
 //!
 //! The presets: `off` = `map none`; `aggressive` and `conservative` = `map batch` with that
 //! `update`; `shared` = `map neighbours`; `warm` = `map neighbours, update aggressive`;
@@ -280,11 +280,12 @@ impl Default for GatherSettings {
             // scene, and shared maps gain only with this budget.
             budget: RayBudget::Candidates,
             placement: ais::Placement::Halton,
-            // Measured: no AIS setting wins at equal time at the default n = 16 on any of our
-            // scenes, so the renderer starts with AIS off.
-            map: MapSource::None,
+            // `auto`. Measured on eleven scenes (BENCHMARKS.md §5.6): the field's guided light
+            // sampling gains 1.4–2.6× at equal time in rooms and courtyards lit by a sky and
+            // stands aside elsewhere (within noise, at most a few percent of overhead).
+            map: MapSource::Field,
             update: Update::Off,
-            map_use: MapUse::Roulette,
+            map_use: MapUse::Both,
             acceptance: Acceptance::Affinity,
             sharing: Sharing::TileOrder,
             tol: map.tol,
