@@ -217,9 +217,10 @@ fn the_default_gather_guides_without_timing_and_is_reproducible() {
 }
 
 #[test]
-fn field_passes_learn_from_four_samples_then_render_the_rest() {
+fn field_passes_learn_from_eight_samples_then_render_the_rest() {
     assert_eq!(gather::field_passes(4), vec![1, 1, 2]);
-    assert_eq!(gather::field_passes(64), vec![1, 1, 2, 60]);
+    assert_eq!(gather::field_passes(64), vec![1, 1, 2, 4, 56]);
+    assert_eq!(gather::field_passes(8), vec![1, 1, 2, 4]);
     assert_eq!(gather::field_passes(5), vec![1, 1, 2, 1]);
     assert_eq!(gather::field_passes(1), vec![1]);
 }

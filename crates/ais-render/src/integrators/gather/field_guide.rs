@@ -19,6 +19,14 @@ use ais::field::{CellIndex, FieldCell, LEAST_EVIDENCE, LOWEST_ACCEPTANCE};
 use std::collections::HashMap;
 use std::sync::Arc;
 
+/// A cell is guided only where fewer than this share of the environment's own draws would
+/// be free (Σ P_t v_t, texels no ray went to counting as blocked): where most are free
+/// (open ground, a sculpture under the sky), guiding saves little variance, makes its rays
+/// dearer (free rays cross the scene) and, where a bright light is partly hidden within a
+/// texel, adds variance. Measured on the default scene: guided everywhere it had contrast,
+/// auto took 34% more time for 11% more relMSE.
+pub const MOST_FREE_DRAWS: f64 = 0.5;
+
 /// The product's default share β of the environment's draws in a guided cell: a field that
 /// wrongly calls a bright direction blocked costs at most 4× in variance there. (0.75 gained
 /// more than 0.5 in the rooms and the courtyard, 1.45× against 1.36× and 2.6× against 2.1×,
@@ -27,6 +35,7 @@ pub const FIELD_GUIDE_FRACTION: f32 = 0.75;
 
 /// A cell is guided only where its darkest texel is below this share of the cell's
 /// visibility: elsewhere the product is close to the environment's own distribution.
+/// (Besides, see [`MOST_FREE_DRAWS`].)
 /// (A rule from the expected variance gain, Σ P_t v_t / m_t against Σ P_t v_t, was tried:
 /// it guided about as many cells and lost 10% of the gain in the sunlit room.)
 pub const GUIDE_CONTRAST: f32 = 0.5;
@@ -86,7 +95,8 @@ impl FieldGuides {
 
 /// The guide of `cell`: each texel weighed by its learned visibility; texels no ray of the
 /// cell went to (behind the surface, or where light sampling never draws) by a tenth of
-/// the cell's. `None` where the cell has too little evidence or too little contrast.
+/// the cell's. `None` where the cell has too little evidence or too little contrast, or
+/// where most of the environment's draws are free anyway.
 fn build(
     partition: &Arc<EnvironmentPartition>,
     cell: &FieldCell,
@@ -94,6 +104,13 @@ fn build(
 ) -> Option<EnvironmentGuide> {
     let visibility = cell.visibility();
     if cell.total().traced < LEAST_EVIDENCE || cell.darkest() >= GUIDE_CONTRAST * visibility {
+        return None;
+    }
+    let texels = (cell.side() * cell.side()) as usize;
+    let free_draws: f64 = (0..texels)
+        .map(|t| partition.texel_mass(t) * cell.texel_visibility_at(t).unwrap_or(0.0) as f64)
+        .sum();
+    if free_draws >= MOST_FREE_DRAWS {
         return None;
     }
     let mut guide = EnvironmentGuide::new(partition.clone());
