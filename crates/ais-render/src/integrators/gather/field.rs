@@ -121,7 +121,14 @@ pub struct FieldPass {
     pub observations: FieldObservations,
     /// Timings of its sampled gathers.
     pub cost: CostSample,
+    /// Its gathers whose light sampling the field guided, and all its gathers with the field.
+    pub guided: [u64; 2],
 }
+
+/// Learning goes on, where the field does not roll, only while at least this share of a
+/// pass's gathers were guided: under an open sky the field guides few cells, and its
+/// learning passes (recording, barriers) would cost 11–14% for nothing.
+pub const LEAST_GUIDED_SHARE: f64 = 0.05;
 
 /// What the gather learns between passes: the visibility field and the measured costs.
 #[derive(Clone, Debug)]
@@ -134,6 +141,12 @@ pub struct GatherLearning {
     pinned_cost_ratio: Option<f32>,
     /// Whether the gathers roll ([`field_rolls`]).
     rolls: bool,
+    /// Guided and all gathers of the pass being merged.
+    guided: [u64; 2],
+    /// The share of guided gathers in the last pass that read a field (`None` before).
+    guided_share: Option<f64>,
+    /// Passes ended.
+    passes: u32,
 }
 
 impl GatherLearning {
@@ -145,6 +158,9 @@ impl GatherLearning {
             cost: CostSample::default(),
             pinned_cost_ratio: settings.cost_ratio,
             rolls: field_rolls(settings),
+            guided: [0; 2],
+            guided_share: None,
+            passes: 0,
         }
     }
 
@@ -165,6 +181,8 @@ impl Learning for GatherLearning {
             // The pass's tiles have dropped their handles: no copy is made.
             Arc::make_mut(&mut self.field).merge(&pass.observations);
             self.cost.add(pass.cost);
+            self.guided[0] += pass.guided[0];
+            self.guided[1] += pass.guided[1];
         }
     }
 
@@ -172,18 +190,28 @@ impl Learning for GatherLearning {
     fn end_pass(&mut self) {
         let cost_ratio = self.cost_ratio();
         Arc::make_mut(&mut self.field).plan(cost_ratio);
+        // The first pass reads an empty field: it guides nothing and says nothing.
+        if self.passes > 0 && self.guided[1] > 0 {
+            self.guided_share = Some(self.guided[0] as f64 / self.guided[1] as f64);
+        }
+        self.guided = [0; 2];
+        self.passes += 1;
     }
 
     /// Learning goes on unless the field's roulette, with enough evidence, stands aside
     /// for nearly every ray (the talk's auto-disable): then the rest of the render is one
-    /// pass. Gathers that do not roll learn for the guides on the full schedule, whatever
-    /// the timings: their images do not depend on the machine.
+    /// pass. Gathers that do not roll learn for the guides while a pass guides at least
+    /// [`LEAST_GUIDED_SHARE`] of its gathers (counts, not timings: their images do not
+    /// depend on the machine).
     fn keeps_learning(&self) -> bool {
-        !self.rolls
-            || self
-                .field
-                .rolling_share()
-                .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
+        if !self.rolls {
+            return self
+                .guided_share
+                .is_none_or(|share| share >= LEAST_GUIDED_SHARE);
+        }
+        self.field
+            .rolling_share()
+            .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
     }
 }
 

@@ -198,6 +198,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
         Some(FieldPass {
             observations,
             cost: std::mem::take(&mut self.cost),
+            guided: [self.field_guided, self.field_gathers.iter().sum::<u64>()],
         })
     }
 
