@@ -826,3 +826,39 @@ fn solid_angle_sampling_beats_area_sampling_near_a_rectangle_light() {
         "solid-angle sampling should win clearly, ratio {ratio}"
     );
 }
+
+fn principled(principled: ais_render::bsdf::Principled) -> Material {
+    Material {
+        scattering: Scattering::Principled(principled),
+        two_sided: false,
+    }
+}
+
+#[test]
+fn principled_sampling_fits_from_both_sides() {
+    use ais_render::bsdf::Principled;
+    // Every lobe at once (clearcoat, sheen, metal, tint, anisotropy, transmission), and a
+    // plain one; each view and its mirror image through the surface (seen from inside).
+    let rich = Principled {
+        base_color: Vec3::new(0.6, 0.3, 0.1),
+        roughness: 0.35,
+        anisotropic: 0.5,
+        metallic: 0.3,
+        spec_trans: 0.5,
+        spec_tint: 0.4,
+        sheen: 0.5,
+        clearcoat: 0.7,
+        clearcoat_gloss: 0.4,
+        ..Principled::default()
+    };
+    let both_sides: Vec<(ShadingFrame, Vec3)> = views()
+        .into_iter()
+        .flat_map(|(frame, wo)| {
+            let below = wo - 2.0 * frame.normal * wo.dot(frame.normal);
+            [(frame, wo), (frame, below)]
+        })
+        .collect();
+    assert_sampling_fits(&principled(rich), 80, &both_sides, "principled, every lobe");
+    let plain = principled(Principled::default());
+    assert_sampling_fits(&plain, 90, &views(), "principled, defaults");
+}

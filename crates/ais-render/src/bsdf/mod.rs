@@ -1,12 +1,13 @@
 //! BSDFs: Mitsuba's `diffuse`, `roughconductor` and `roughplastic` (GGX, visible-normal
 //! sampling), the smooth `conductor`, `plastic`, `dielectric` and `thindielectric`, and the
-//! `twosided` adapter, each evaluating as Mitsuba 3 does.
+//! `twosided` adapter, and Mitsuba's `principled`, each evaluating as Mitsuba 3 does.
 
 mod conductors;
 mod hit;
 mod microfacet;
 mod parameter_textures;
 mod polarized_plastic;
+mod principled;
 mod reader;
 mod rough_dielectric;
 mod rough_plastic;
@@ -20,9 +21,10 @@ pub use hit::{HitBsdf, Mixture, MixturePart};
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
 pub(crate) use parameter_textures::parameter_texture;
 pub use parameter_textures::{
-    material_textures, ParameterTexture, TextureScene, TexturedParameter,
+    material_textures, ParameterTexture, PrincipledWeight, TextureScene, TexturedParameter,
 };
 pub use polarized_plastic::PolarizedPlastic;
+pub use principled::{eta_from_specular, Principled, SamplingRates};
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
@@ -74,6 +76,9 @@ pub enum Scattering {
     RoughDielectric(RoughDielectric),
     /// Mitsuba's `pplastic`, unpolarized: microfacet reflection over a diffuse base.
     PolarizedPlastic(PolarizedPlastic),
+    /// Mitsuba's `principled`: Burley's BSDF with its specular, transmitting, diffuse,
+    /// sheen and clearcoat lobes.
+    Principled(Principled),
 }
 
 /// A direction drawn from a BSDF.
@@ -215,6 +220,7 @@ impl Material {
             Scattering::RoughConductor { microfacet, .. } => microfacet.is_anisotropic(),
             Scattering::RoughDielectric(rough) => rough.microfacet.is_anisotropic(),
             Scattering::PolarizedPlastic(plastic) => plastic.microfacet.is_anisotropic(),
+            Scattering::Principled(principled) => principled.is_anisotropic(),
             _ => false,
         }
     }
@@ -251,7 +257,12 @@ impl Material {
     /// front side of the shading and geometric normals. Smooth conductors and dielectrics
     /// have no continuous part: only their specular lobes ([`Material::sample_lobe`]) carry.
     pub fn in_support(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> bool {
-        if let Scattering::RoughDielectric(_) = self.scattering {
+        let transmits = match &self.scattering {
+            Scattering::RoughDielectric(_) => true,
+            Scattering::Principled(principled) => principled.transmits(),
+            _ => false,
+        };
+        if transmits {
             // Either side, where the shading and geometric normals agree on it.
             let agrees = |w: Vec3| frame.normal.dot(w) * frame.geometric.dot(w) > 0.0;
             return agrees(wo) && agrees(wi);
@@ -291,6 +302,7 @@ impl Material {
             Scattering::Plastic(ref plastic) => plastic.eval(o, i),
             Scattering::RoughDielectric(ref rough) => rough.eval(o, i),
             Scattering::PolarizedPlastic(ref plastic) => plastic.eval(o, i),
+            Scattering::Principled(ref principled) => principled.eval(o, i),
             // No continuous part (outside the support).
             Scattering::Conductor { .. } | Scattering::Dielectric(_) => Vec3::ZERO,
         }
@@ -328,6 +340,9 @@ impl Material {
             Scattering::PolarizedPlastic(ref plastic) => {
                 specular::LobeSample::Continuous(plastic.sample(o, u)?)
             }
+            Scattering::Principled(ref principled) => {
+                specular::LobeSample::Continuous(principled.sample(o, u)?)
+            }
             Scattering::Conductor { eta, k, specular } => {
                 specular::LobeSample::Specular(specular::conductor_lobe(o, eta, k, specular)?)
             }
@@ -353,8 +368,10 @@ impl Material {
     /// Density of [`Material::sample`] at `wi`.
     pub fn pdf(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> f64 {
         let (o, i) = (frame.to_local(wo), frame.to_local(wi));
-        if let Scattering::RoughDielectric(ref rough) = self.scattering {
-            return rough.pdf(o, i) as f64;
+        match self.scattering {
+            Scattering::RoughDielectric(ref rough) => return rough.pdf(o, i) as f64,
+            Scattering::Principled(ref principled) => return principled.pdf(o, i) as f64,
+            _ => {}
         }
         if i.z <= 0.0 {
             return 0.0;
@@ -388,11 +405,12 @@ impl Material {
                 plastic.pdf(o, i)
             }
             Scattering::PolarizedPlastic(ref plastic) => plastic.pdf(o, i),
-            // Point masses only: no density over directions (the rough dielectric returned
-            // above).
+            // Point masses only: no density over directions (the rough dielectric and the
+            // principled BSDF returned above).
             Scattering::Conductor { .. }
             | Scattering::Dielectric(_)
-            | Scattering::RoughDielectric(_) => 0.0,
+            | Scattering::RoughDielectric(_)
+            | Scattering::Principled(_) => 0.0,
         }) as f64
     }
 }
@@ -470,6 +488,42 @@ mod tests {
         assert!(
             all.contains("Unobtainium") && all.contains("sheen") && all.contains("kryptonite"),
             "{all}"
+        );
+    }
+
+    #[test]
+    fn principled_reads_its_defaults_and_refuses_eta_with_specular() {
+        let (m, warnings) = materials(
+            r#"<bsdf type="principled" id="a"/>
+               <bsdf type="principled" id="b"><float name="metallic" value="1.5"/><float name="eta" value="1.33"/></bsdf>"#,
+        );
+        assert_eq!(
+            m[0].scattering,
+            Scattering::Principled(Principled::default())
+        );
+        match &m[1].scattering {
+            Scattering::Principled(p) => assert!(p.metallic == 1.0 && p.eta == 1.33),
+            other => panic!("{other:?}"),
+        }
+        assert!(
+            warnings
+                .join("\n")
+                .contains("m.xml:2: \"metallic\" = 1.5 lies outside [0, 1]"),
+            "{warnings:?}"
+        );
+        let xml = r#"<scene version="3.0.0"><bsdf type="principled" id="c"><float name="eta" value="1.5"/><float name="specular" value="0.5"/></bsdf></scene>"#;
+        let scene = parse_scene(Path::new("m.xml"), xml, &[]).unwrap();
+        let error = Material::from_plugin(
+            &scene.bsdfs[0],
+            Path::new("m.xml"),
+            &scene.bsdfs,
+            &mut Vec::new(),
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            error.contains("m.xml:1") && error.contains("not both"),
+            "{error}"
         );
     }
 }

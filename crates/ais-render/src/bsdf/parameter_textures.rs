@@ -41,12 +41,42 @@ pub enum TexturedParameter {
     RoughnessU,
     /// The roughness across the tangent, α_v (one channel).
     RoughnessV,
+    /// A weight of the principled BSDF (one channel).
+    Principled(PrincipledWeight),
+}
+
+/// The principled BSDF's one-channel parameters that textures may give.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PrincipledWeight {
+    /// `roughness`.
+    Roughness,
+    /// `anisotropic`.
+    Anisotropic,
+    /// `metallic`.
+    Metallic,
+    /// `spec_trans`.
+    SpecTrans,
+    /// `spec_tint`.
+    SpecTint,
+    /// `sheen`.
+    Sheen,
+    /// `sheen_tint`.
+    SheenTint,
+    /// `flatness`.
+    Flatness,
+    /// `clearcoat`.
+    Clearcoat,
+    /// `clearcoat_gloss`.
+    ClearcoatGloss,
 }
 
 impl TexturedParameter {
     /// Whether a texture gives it as one channel (a roughness) rather than a colour.
     pub fn is_scalar(self) -> bool {
-        matches!(self, Self::Roughness | Self::RoughnessU | Self::RoughnessV)
+        matches!(
+            self,
+            Self::Roughness | Self::RoughnessU | Self::RoughnessV | Self::Principled(_)
+        )
     }
 }
 
@@ -81,6 +111,22 @@ pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, Textur
             ("alpha", Roughness),
             ("alpha_u", RoughnessU),
             ("alpha_v", RoughnessV),
+        ],
+        "principled" => &[
+            ("base_color", Albedo),
+            ("roughness", Principled(PrincipledWeight::Roughness)),
+            ("anisotropic", Principled(PrincipledWeight::Anisotropic)),
+            ("metallic", Principled(PrincipledWeight::Metallic)),
+            ("spec_trans", Principled(PrincipledWeight::SpecTrans)),
+            ("spec_tint", Principled(PrincipledWeight::SpecTint)),
+            ("sheen", Principled(PrincipledWeight::Sheen)),
+            ("sheen_tint", Principled(PrincipledWeight::SheenTint)),
+            ("flatness", Principled(PrincipledWeight::Flatness)),
+            ("clearcoat", Principled(PrincipledWeight::Clearcoat)),
+            (
+                "clearcoat_gloss",
+                Principled(PrincipledWeight::ClearcoatGloss),
+            ),
         ],
         "dielectric" | "thindielectric" => &[
             ("specular_reflectance", SpecularReflectance),
@@ -207,9 +253,31 @@ impl Material {
             (Scattering::RoughDielectric(d), Roughness | RoughnessU | RoughnessV) => {
                 d.microfacet = with_roughness(d.microfacet, parameter, value.x)
             }
+            (Scattering::Principled(p), Albedo) => p.base_color = albedo,
+            (Scattering::Principled(p), Principled(weight)) => {
+                set_principled_weight(p, weight, value.x.clamp(0.0, 1.0))
+            }
             _ => {}
         }
     }
+}
+
+/// Sets one of the principled BSDF's weights.
+fn set_principled_weight(principled: &mut super::Principled, weight: PrincipledWeight, value: f32) {
+    use PrincipledWeight::*;
+    let field = match weight {
+        Roughness => &mut principled.roughness,
+        Anisotropic => &mut principled.anisotropic,
+        Metallic => &mut principled.metallic,
+        SpecTrans => &mut principled.spec_trans,
+        SpecTint => &mut principled.spec_tint,
+        Sheen => &mut principled.sheen,
+        SheenTint => &mut principled.sheen_tint,
+        Flatness => &mut principled.flatness,
+        Clearcoat => &mut principled.clearcoat,
+        ClearcoatGloss => &mut principled.clearcoat_gloss,
+    };
+    *field = value;
 }
 
 /// `microfacet` with the roughness `parameter` (both, or one axis) set to `alpha`.

@@ -3,8 +3,9 @@
 //! line.
 
 use super::{
-    named_conductor, Dielectric, Material, Microfacet, MicrofacetKind, PolarizedPlastic,
-    RoughDielectric, RoughPlastic, Scattering, SmoothPlastic,
+    eta_from_specular, named_conductor, Dielectric, Material, Microfacet, MicrofacetKind,
+    PolarizedPlastic, Principled, RoughDielectric, RoughPlastic, SamplingRates, Scattering,
+    SmoothPlastic,
 };
 use crate::error::InputError;
 use crate::scene::{ColourRole, Plugin, Property};
@@ -92,6 +93,24 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
             "diffuse_reflectance",
             "specular_reflectance",
             "sample_visible",
+        ],
+        "principled" => &[
+            "base_color",
+            "roughness",
+            "anisotropic",
+            "metallic",
+            "spec_trans",
+            "eta",
+            "specular",
+            "spec_tint",
+            "sheen",
+            "sheen_tint",
+            "flatness",
+            "clearcoat",
+            "clearcoat_gloss",
+            "diffuse_reflectance_sampling_rate",
+            "main_specular_sampling_rate",
+            "clearcoat_sampling_rate",
         ],
         "roughplastic" => &[
             "distribution",
@@ -204,6 +223,7 @@ impl BsdfReader<'_> {
             "thindielectric" => self.dielectric(true),
             "roughdielectric" => self.rough_dielectric(),
             "pplastic" => self.polarized_plastic(),
+            "principled" => self.principled()?,
             "twosided" => Material {
                 two_sided: true,
                 ..self.nested()?
@@ -496,5 +516,132 @@ impl BsdfReader<'_> {
             "int_ior / ext_ior = {eta} must be positive and not 1; using {fallback}"
         ));
         fallback
+    }
+
+    /// Mitsuba's `principled`: every weight in [0, 1] (else clamped, with a warning), the
+    /// index from `eta` or from `specular` (both is an error, as in Mitsuba), and Mitsuba's
+    /// nudges where light passes through (η = 1 becomes 1.001, `specular` 0 becomes 0.001).
+    fn principled(&mut self) -> Result<Material, InputError> {
+        let plugin = self.plugin;
+        let has = |name: &str| {
+            plugin.properties.contains_key(name)
+                || plugin
+                    .children
+                    .iter()
+                    .any(|c| c.name.as_deref() == Some(name))
+                || plugin
+                    .references
+                    .iter()
+                    .any(|r| r.0.as_deref() == Some(name))
+        };
+        if plugin.properties.contains_key("eta") && plugin.properties.contains_key("specular") {
+            return Err(InputError::at(
+                self.file,
+                plugin.line,
+                "principled: give \"eta\" or \"specular\", not both".to_string(),
+            ));
+        }
+        let defaults = Principled::default();
+        let mut weight = |name: &str, default: f32| self.unit_weight(name, default);
+        let mut principled = Principled {
+            base_color: Vec3::ZERO,
+            roughness: weight("roughness", defaults.roughness),
+            anisotropic: weight("anisotropic", 0.0),
+            metallic: weight("metallic", 0.0),
+            spec_trans: weight("spec_trans", 0.0),
+            eta: 1.5,
+            spec_tint: weight("spec_tint", 0.0),
+            sheen: weight("sheen", 0.0),
+            sheen_tint: weight("sheen_tint", 0.0),
+            flatness: weight("flatness", 0.0),
+            clearcoat: weight("clearcoat", 0.0),
+            clearcoat_gloss: weight("clearcoat_gloss", 0.0),
+            rates: SamplingRates {
+                diffuse: self.rate("diffuse_reflectance_sampling_rate"),
+                specular: self.rate("main_specular_sampling_rate"),
+                clearcoat: self.rate("clearcoat_sampling_rate"),
+            },
+        };
+        principled.base_color = self
+            .colour("base_color", defaults.base_color)
+            .min(Vec3::ONE);
+        // Mitsuba's flag: given, as a texture or a number other than 0.
+        let zero = matches!(
+            plugin.properties.get("spec_trans").map(|p| &p.value),
+            Some(Property::Float(v)) if *v == 0.0
+        );
+        let transmits = has("spec_trans") && !zero;
+        principled.eta = if plugin.properties.contains_key("eta") {
+            let eta = self.positive("eta", 1.5);
+            if transmits && eta == 1.0 {
+                1.001
+            } else {
+                eta
+            }
+        } else {
+            let specular = self.unit_weight("specular", 0.5);
+            let specular = if transmits && specular == 0.0 {
+                1e-3
+            } else {
+                specular
+            };
+            eta_from_specular(specular)
+        };
+        Ok(Material {
+            scattering: Scattering::Principled(principled),
+            two_sided: false,
+        })
+    }
+
+    /// A float property meant to lie in [0, 1]: clamped there, with a warning if outside;
+    /// `default` with a warning if it is not a finite number.
+    fn unit_weight(&mut self, name: &str, default: f32) -> f32 {
+        match self.plugin.float(name, default as f64) {
+            Ok(v) if (0.0..=1.0).contains(&v) => v as f32,
+            Ok(v) if v.is_finite() => {
+                self.warn(format!("\"{name}\" = {v} lies outside [0, 1]; clamped"));
+                v.clamp(0.0, 1.0) as f32
+            }
+            Ok(v) => {
+                self.warn(format!("\"{name}\" = {v} is not a number; using {default}"));
+                default
+            }
+            Err((_, message)) => {
+                self.warn(format!("{message}; using {name} = {default}"));
+                default
+            }
+        }
+    }
+
+    /// A positive finite float property, else `default` with a warning.
+    fn positive(&mut self, name: &str, default: f32) -> f32 {
+        match self.plugin.float(name, default as f64) {
+            Ok(v) if v.is_finite() && v > 0.0 => v as f32,
+            Ok(v) => {
+                self.warn(format!(
+                    "\"{name}\" = {v} must be positive; using {default}"
+                ));
+                default
+            }
+            Err((_, message)) => {
+                self.warn(format!("{message}; using {name} = {default}"));
+                default
+            }
+        }
+    }
+
+    /// A lobe's sampling rate (default 1, as Mitsuba's code has it): ≥ 0.
+    fn rate(&mut self, name: &str) -> f32 {
+        match self.plugin.float(name, 1.0) {
+            Ok(v) if v.is_finite() && v >= 0.0 => v as f32,
+            Ok(v) => {
+                self.warn(format!("\"{name}\" = {v} must be ≥ 0; using 1"));
+                1.0
+            }
+            Err((_, message)) => {
+                self.warn(format!("{message}; using {name} = 1"));
+                1.0
+            }
+        }
     }
 }

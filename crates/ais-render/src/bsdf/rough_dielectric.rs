@@ -134,15 +134,7 @@ impl RoughDielectric {
         let i = if reflect {
             2.0 * oh * h - o
         } else {
-            // Snell at the microfacet, turned toward o.
-            let (facing, cos_o) = (h * oh.signum(), oh.abs());
-            let eta = self.eta_from(o);
-            let sin2_t = (1.0 - cos_o * cos_o) / (eta * eta);
-            if sin2_t >= 1.0 {
-                return None;
-            }
-            let cos_t = (1.0 - sin2_t).sqrt();
-            (facing * (cos_o / eta - cos_t) - o / eta).normalize()
+            refract(o, h, self.eta_from(o))?
         };
         let on_its_side = if reflect {
             i.z * o.z > 0.0
@@ -151,6 +143,19 @@ impl RoughDielectric {
         };
         (on_its_side && i.is_finite()).then_some(i)
     }
+}
+
+/// `o` refracted through the microfacet `h` into a medium of relative index `eta` (beyond
+/// over before, seen from `o`), by Snell's law (`None` under total internal reflection).
+pub(super) fn refract(o: Vec3, h: Vec3, eta: f32) -> Option<Vec3> {
+    let oh = o.dot(h);
+    let (facing, cos_o) = (h * oh.signum(), oh.abs());
+    let sin2_t = (1.0 - cos_o * cos_o) / (eta * eta);
+    if sin2_t >= 1.0 {
+        return None;
+    }
+    let cos_t = (1.0 - sin2_t).sqrt();
+    Some((facing * (cos_o / eta - cos_t) - o / eta).normalize())
 }
 
 #[cfg(test)]
