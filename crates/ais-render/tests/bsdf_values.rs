@@ -275,3 +275,78 @@ fn principled_matches_mitsuba() {
         5e-3,
     );
 }
+
+#[test]
+fn principled_thin_matches_mitsuba() {
+    use ais_render::bsdf::PrincipledThin;
+    use std::f32::consts::PI;
+    let material = |thin: PrincipledThin| Material {
+        scattering: Scattering::PrincipledThin(thin),
+        two_sided: true,
+    };
+    // base_color (0.6, 0.3, 0.1), every other parameter at its default (no specular lobe without spec_trans, as in Mitsuba).
+    check(
+        &material(PrincipledThin {
+            base_color: Vec3::new(0.6, 0.3, 0.1),
+            ..PrincipledThin::default()
+        }),
+        &[
+            (0.2, 0.4, 2.5, [0.1759099, 0.08795496, 0.02931832]),
+            (1.0, 0.3, 1.0, [0.1836742, 0.09183709, 0.03061236]),
+            (0.5, 0.5, PI, [0.1676084, 0.08380421, 0.02793473]),
+            (1.3, 1.2, 3.0, [0.06077674, 0.03038837, 0.01012946]),
+            (0.3, 2.5, 0.7, [0.0, 0.0, 0.0]),
+            (0.3, 2.9, PI, [0.0, 0.0, 0.0]),
+            (0.6, 2.6, 0.0, [0.0, 0.0, 0.0]),
+            (1.1, 2.0, 0.2, [0.0, 0.0, 0.0]),
+        ],
+        5e-3,
+    );
+    // base_color (0.3, 0.6, 0.1), diff_trans 0.8, roughness 0.6, sheen 0.4, sheen_tint 0.5, flatness 0.5.
+    check(
+        &material(PrincipledThin {
+            base_color: Vec3::new(0.3, 0.6, 0.1),
+            diffuse_transmission: 0.4,
+            roughness: 0.6,
+            sheen: 0.4,
+            sheen_tint: 0.5,
+            flatness: 0.5,
+            ..PrincipledThin::default()
+        }),
+        &[
+            (0.2, 0.4, 2.5, [0.04373574, 0.08747146, 0.01457859]),
+            (1.0, 0.3, 1.0, [0.05045874, 0.1009167, 0.01682007]),
+            (0.5, 0.5, PI, [0.04305097, 0.08609906, 0.01435225]),
+            (1.3, 1.2, 3.0, [0.03581226, 0.06541177, 0.01607926]),
+            (0.3, 2.5, 0.7, [0.03060143, 0.06120286, 0.01020048]),
+            (0.3, 2.9, PI, [0.03708787, 0.07417574, 0.01236262]),
+            (0.6, 2.6, 0.0, [0.03273074, 0.06546148, 0.01091025]),
+            (1.1, 2.0, 0.2, [0.01589564, 0.03179128, 0.005298547]),
+        ],
+        5e-3,
+    );
+    // base_color (0.9, 0.8, 0.5), spec_trans 0.6, eta 1.33, roughness 0.3, spec_tint 0.4, diff_trans 0.5, anisotropic 0.5.
+    check(
+        &material(PrincipledThin {
+            base_color: Vec3::new(0.9, 0.8, 0.5),
+            spec_trans: 0.6,
+            eta: 1.33,
+            roughness: 0.3,
+            spec_tint: 0.4,
+            diffuse_transmission: 0.25,
+            anisotropic: 0.5,
+            ..PrincipledThin::default()
+        }),
+        &[
+            (0.2, 0.4, 2.5, [0.08534282, 0.07625346, 0.04898539]),
+            (1.0, 0.3, 1.0, [0.08245177, 0.0733132, 0.04589748]),
+            (0.5, 0.5, PI, [0.2201284, 0.2050231, 0.159707]),
+            (1.3, 1.2, 3.0, [0.05527527, 0.05212072, 0.04265706]),
+            (0.3, 2.5, 0.7, [0.02401054, 0.02134271, 0.01333919]),
+            (0.3, 2.9, PI, [23.33352, 20.74091, 12.96307]),
+            (0.6, 2.6, 0.0, [0.02566554, 0.02281381, 0.01425863]),
+            (1.1, 2.0, 0.2, [0.01192173, 0.01059709, 0.006623182]),
+        ],
+        5e-3,
+    );
+}

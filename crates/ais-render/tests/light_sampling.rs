@@ -862,3 +862,29 @@ fn principled_sampling_fits_from_both_sides() {
     let plain = principled(Principled::default());
     assert_sampling_fits(&plain, 90, &views(), "principled, defaults");
 }
+
+#[test]
+fn principled_thin_sampling_fits_from_both_sides() {
+    use ais_render::bsdf::PrincipledThin;
+    // Specular reflection and transmission, diffuse reflection and transmission at once.
+    let thin = Material {
+        scattering: Scattering::PrincipledThin(PrincipledThin {
+            base_color: Vec3::new(0.3, 0.6, 0.1),
+            roughness: 0.4,
+            anisotropic: 0.3,
+            spec_trans: 0.5,
+            diffuse_transmission: 0.3,
+            sheen: 0.5,
+            ..PrincipledThin::default()
+        }),
+        two_sided: true,
+    };
+    let both_sides: Vec<(ShadingFrame, Vec3)> = views()
+        .into_iter()
+        .flat_map(|(frame, wo)| {
+            let below = wo - 2.0 * frame.normal * wo.dot(frame.normal);
+            [(frame, wo), (frame, below)]
+        })
+        .collect();
+    assert_sampling_fits(&thin, 100, &both_sides, "principledthin");
+}

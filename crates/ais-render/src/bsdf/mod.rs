@@ -1,6 +1,6 @@
 //! BSDFs: Mitsuba's `diffuse`, `roughconductor` and `roughplastic` (GGX, visible-normal
 //! sampling), the smooth `conductor`, `plastic`, `dielectric` and `thindielectric`, and the
-//! `twosided` adapter, and Mitsuba's `principled`, each evaluating as Mitsuba 3 does.
+//! `twosided` adapter, and Mitsuba's `principled` and `principledthin`, each evaluating as Mitsuba 3 does.
 
 mod conductors;
 mod hit;
@@ -8,6 +8,7 @@ mod microfacet;
 mod parameter_textures;
 mod polarized_plastic;
 mod principled;
+mod principled_thin;
 mod reader;
 mod rough_dielectric;
 mod rough_plastic;
@@ -25,6 +26,7 @@ pub use parameter_textures::{
 };
 pub use polarized_plastic::PolarizedPlastic;
 pub use principled::{eta_from_specular, Principled, SamplingRates};
+pub use principled_thin::{PrincipledThin, ThinSamplingRates};
 pub use rough_dielectric::RoughDielectric;
 pub use rough_plastic::RoughPlastic;
 pub use specular::{diffuse_fresnel_reflectance, Dielectric, SmoothPlastic};
@@ -79,6 +81,9 @@ pub enum Scattering {
     /// Mitsuba's `principled`: Burley's BSDF with its specular, transmitting, diffuse,
     /// sheen and clearcoat lobes.
     Principled(Principled),
+    /// Mitsuba's `principledthin`: the principled BSDF of a thin sheet, the same from both
+    /// sides, with diffuse and specular transmission.
+    PrincipledThin(PrincipledThin),
 }
 
 /// A direction drawn from a BSDF.
@@ -221,6 +226,7 @@ impl Material {
             Scattering::RoughDielectric(rough) => rough.microfacet.is_anisotropic(),
             Scattering::PolarizedPlastic(plastic) => plastic.microfacet.is_anisotropic(),
             Scattering::Principled(principled) => principled.is_anisotropic(),
+            Scattering::PrincipledThin(thin) => thin.is_anisotropic(),
             _ => false,
         }
     }
@@ -260,6 +266,7 @@ impl Material {
         let transmits = match &self.scattering {
             Scattering::RoughDielectric(_) => true,
             Scattering::Principled(principled) => principled.transmits(),
+            Scattering::PrincipledThin(thin) => thin.transmits(),
             _ => false,
         };
         if transmits {
@@ -303,6 +310,7 @@ impl Material {
             Scattering::RoughDielectric(ref rough) => rough.eval(o, i),
             Scattering::PolarizedPlastic(ref plastic) => plastic.eval(o, i),
             Scattering::Principled(ref principled) => principled.eval(o, i),
+            Scattering::PrincipledThin(ref thin) => thin.eval(o, i),
             // No continuous part (outside the support).
             Scattering::Conductor { .. } | Scattering::Dielectric(_) => Vec3::ZERO,
         }
@@ -343,6 +351,9 @@ impl Material {
             Scattering::Principled(ref principled) => {
                 specular::LobeSample::Continuous(principled.sample(o, u)?)
             }
+            Scattering::PrincipledThin(ref thin) => {
+                specular::LobeSample::Continuous(thin.sample(o, u)?)
+            }
             Scattering::Conductor { eta, k, specular } => {
                 specular::LobeSample::Specular(specular::conductor_lobe(o, eta, k, specular)?)
             }
@@ -371,6 +382,7 @@ impl Material {
         match self.scattering {
             Scattering::RoughDielectric(ref rough) => return rough.pdf(o, i) as f64,
             Scattering::Principled(ref principled) => return principled.pdf(o, i) as f64,
+            Scattering::PrincipledThin(ref thin) => return thin.pdf(o, i) as f64,
             _ => {}
         }
         if i.z <= 0.0 {
@@ -406,11 +418,12 @@ impl Material {
             }
             Scattering::PolarizedPlastic(ref plastic) => plastic.pdf(o, i),
             // Point masses only: no density over directions (the rough dielectric and the
-            // principled BSDF returned above).
+            // principled BSDFs returned above).
             Scattering::Conductor { .. }
             | Scattering::Dielectric(_)
             | Scattering::RoughDielectric(_)
-            | Scattering::Principled(_) => 0.0,
+            | Scattering::Principled(_)
+            | Scattering::PrincipledThin(_) => 0.0,
         }) as f64
     }
 }

@@ -68,6 +68,8 @@ pub enum PrincipledWeight {
     Clearcoat,
     /// `clearcoat_gloss`.
     ClearcoatGloss,
+    /// `diff_trans` of the thin sheet (from 0 to 2).
+    DiffTrans,
 }
 
 impl TexturedParameter {
@@ -127,6 +129,17 @@ pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, Textur
                 "clearcoat_gloss",
                 Principled(PrincipledWeight::ClearcoatGloss),
             ),
+        ],
+        "principledthin" => &[
+            ("base_color", Albedo),
+            ("roughness", Principled(PrincipledWeight::Roughness)),
+            ("anisotropic", Principled(PrincipledWeight::Anisotropic)),
+            ("spec_trans", Principled(PrincipledWeight::SpecTrans)),
+            ("diff_trans", Principled(PrincipledWeight::DiffTrans)),
+            ("spec_tint", Principled(PrincipledWeight::SpecTint)),
+            ("sheen", Principled(PrincipledWeight::Sheen)),
+            ("sheen_tint", Principled(PrincipledWeight::SheenTint)),
+            ("flatness", Principled(PrincipledWeight::Flatness)),
         ],
         "dielectric" | "thindielectric" => &[
             ("specular_reflectance", SpecularReflectance),
@@ -257,6 +270,10 @@ impl Material {
             (Scattering::Principled(p), Principled(weight)) => {
                 set_principled_weight(p, weight, value.x.clamp(0.0, 1.0))
             }
+            (Scattering::PrincipledThin(p), Albedo) => p.base_color = albedo,
+            (Scattering::PrincipledThin(p), Principled(weight)) => {
+                set_thin_weight(p, weight, value.x)
+            }
             _ => {}
         }
     }
@@ -276,8 +293,27 @@ fn set_principled_weight(principled: &mut super::Principled, weight: PrincipledW
         Flatness => &mut principled.flatness,
         Clearcoat => &mut principled.clearcoat,
         ClearcoatGloss => &mut principled.clearcoat_gloss,
+        DiffTrans => return,
     };
     *field = value;
+}
+
+/// Sets one of the thin principled BSDF's weights (`diff_trans` runs from 0 to 2; the others
+/// from 0 to 1).
+fn set_thin_weight(thin: &mut super::PrincipledThin, weight: PrincipledWeight, value: f32) {
+    use PrincipledWeight::*;
+    let unit = value.clamp(0.0, 1.0);
+    match weight {
+        Roughness => thin.roughness = unit,
+        Anisotropic => thin.anisotropic = unit,
+        SpecTrans => thin.spec_trans = unit,
+        DiffTrans => thin.diffuse_transmission = value.clamp(0.0, 2.0) / 2.0,
+        SpecTint => thin.spec_tint = unit,
+        Sheen => thin.sheen = unit,
+        SheenTint => thin.sheen_tint = unit,
+        Flatness => thin.flatness = unit,
+        Metallic | Clearcoat | ClearcoatGloss => {}
+    }
 }
 
 /// `microfacet` with the roughness `parameter` (both, or one axis) set to `alpha`.

@@ -142,31 +142,13 @@ impl Principled {
         self.anisotropic > 0.0
     }
 
-    /// The main lobes' GGX distribution (Mitsuba's `calc_dist_params`; α may exceed 1 when
-    /// anisotropic, as in Mitsuba).
+    /// The main lobes' GGX distribution.
     fn microfacet(&self) -> Microfacet {
-        let alpha = self.roughness * self.roughness;
-        let aspect = (1.0 - 0.9 * self.anisotropic).max(0.0).sqrt();
-        let (alpha_u, alpha_v) = if self.is_anisotropic() {
-            (alpha / aspect, alpha * aspect)
-        } else {
-            (alpha, alpha)
-        };
-        Microfacet {
-            kind: MicrofacetKind::Ggx,
-            alpha_u: alpha_u.max(1e-3),
-            alpha_v: alpha_v.max(1e-3),
-        }
+        ggx(self.roughness, self.anisotropic)
     }
 
-    /// The base colour over its luminance (white where it is black).
     fn tint(&self) -> Vec3 {
-        let lum = luminance(self.base_color);
-        if lum > 0.0 {
-            self.base_color / lum
-        } else {
-            Vec3::ONE
-        }
+        tint(self.base_color)
     }
 
     fn pair(&self, o: Vec3, i: Vec3) -> Pair {
@@ -254,22 +236,13 @@ impl Principled {
     /// The diffuse lobe (Burley's, with retro-reflection, blended toward the flattened one)
     /// and the sheen, front side only.
     fn diffuse_and_sheen(&self, o: Vec3, i: Vec3, h: Vec3, reflecting: f32) -> Vec3 {
-        let (fo, fi) = (schlick_weight(i.z), schlick_weight(o.z));
-        let diffuse = (1.0 - 0.5 * fi) * (1.0 - 0.5 * fo);
         let cos_d = h.dot(i);
-        let rr = 2.0 * self.roughness * cos_d * cos_d;
-        let retro = rr * (fo + fi + fo * fi * (rr - 1.0));
-        let flat = {
-            let fss90 = rr / 2.0;
-            let fss = (1.0 + (fss90 - 1.0) * fo) * (1.0 + (fss90 - 1.0) * fi);
-            1.25 * (fss * (1.0 / (i.z + o.z) - 0.5) + 0.5)
-        };
-        let shape = diffuse + retro + self.flatness * (flat - diffuse - retro);
+        let shape = burley_diffuse(self.roughness, self.flatness, o.z, i.z, cos_d);
         let mut value = self.base_color * (reflecting * i.z / PI * shape);
         let dielectric = 1.0 - self.metallic;
         if self.sheen > 0.0 && dielectric > 0.0 {
-            let colour = Vec3::ONE + self.sheen_tint * (self.tint() - Vec3::ONE);
-            value += colour * (self.sheen * dielectric * schlick_weight(cos_d.abs()) * i.z);
+            let sheen = sheen(self.base_color, self.sheen_tint, cos_d);
+            value += sheen * (self.sheen * dielectric * i.z);
         }
         value
     }
@@ -302,7 +275,14 @@ impl Principled {
             return None;
         }
         let probabilities = self.lobe_probabilities(o)?;
-        let (lobe, u0) = pick_lobe(probabilities, u[0]);
+        const LOBES: [Lobe; 4] = [
+            Lobe::Diffuse,
+            Lobe::Clearcoat,
+            Lobe::Transmission,
+            Lobe::Reflection,
+        ];
+        let (index, u0) = pick_lobe(probabilities, u[0]);
+        let lobe = LOBES[index];
         let u = [u0, u[1]];
         let upper = o * o.z.signum();
         let i = match lobe {
@@ -356,32 +336,77 @@ impl Principled {
     }
 }
 
-/// The lobe that `u` picks among `probabilities`, and `u` rescaled to [0, 1) within it.
-fn pick_lobe(probabilities: [f32; 4], u: f32) -> (Lobe, f32) {
-    const LOBES: [Lobe; 4] = [
-        Lobe::Diffuse,
-        Lobe::Clearcoat,
-        Lobe::Transmission,
-        Lobe::Reflection,
-    ];
+/// The index of the lobe that `u` picks among `probabilities` (summing to 1), and `u`
+/// rescaled to [0, 1) within it.
+pub(super) fn pick_lobe(probabilities: [f32; 4], u: f32) -> (usize, f32) {
+    let last = (0..4).rev().find(|&k| probabilities[k] > 0.0).unwrap_or(3);
     let mut start = 0.0;
-    for (lobe, p) in LOBES.into_iter().zip(probabilities) {
-        if p > 0.0 && (u < start + p || lobe == Lobe::Reflection) {
-            return (lobe, ((u - start) / p).clamp(0.0, 1.0 - 1e-7));
+    for (k, &p) in probabilities.iter().enumerate().take(last + 1) {
+        if p > 0.0 && (u < start + p || k == last) {
+            return (k, ((u - start) / p).clamp(0.0, 1.0 - 1e-7));
         }
         start += p;
     }
-    // Only reachable when reflection has no probability: take the last lobe that has one.
-    let last = (0..4).rev().find(|&k| probabilities[k] > 0.0).unwrap_or(3);
-    let start: f32 = probabilities[..last].iter().sum();
-    (
-        LOBES[last],
-        ((u - start) / probabilities[last]).clamp(0.0, 1.0 - 1e-7),
-    )
+    (last, 0.0)
+}
+
+/// The GGX distribution of `roughness` and `anisotropic` (Mitsuba's `calc_dist_params`:
+/// α = roughness², stretched by anisotropy; α may exceed 1 when anisotropic, as in
+/// Mitsuba).
+pub(super) fn ggx(roughness: f32, anisotropic: f32) -> Microfacet {
+    let alpha = roughness * roughness;
+    let aspect = (1.0 - 0.9 * anisotropic).max(0.0).sqrt();
+    let (alpha_u, alpha_v) = if anisotropic > 0.0 {
+        (alpha / aspect, alpha * aspect)
+    } else {
+        (alpha, alpha)
+    };
+    Microfacet {
+        kind: MicrofacetKind::Ggx,
+        alpha_u: alpha_u.max(1e-3),
+        alpha_v: alpha_v.max(1e-3),
+    }
+}
+
+/// The base colour over its luminance (white where it is black).
+pub(super) fn tint(base_color: Vec3) -> Vec3 {
+    let lum = luminance(base_color);
+    if lum > 0.0 {
+        base_color / lum
+    } else {
+        Vec3::ONE
+    }
+}
+
+/// Burley's diffuse shape (times π / albedo): Fresnel-shaped, with retro-reflection that
+/// grows with `roughness`, blended toward the flattened (fake subsurface) lobe by
+/// `flatness`; `cos_o`, `cos_i` at the normal (both above), `cos_d` between the half
+/// vector and the light.
+pub(super) fn burley_diffuse(
+    roughness: f32,
+    flatness: f32,
+    cos_o: f32,
+    cos_i: f32,
+    cos_d: f32,
+) -> f32 {
+    let (fo, fi) = (schlick_weight(cos_i), schlick_weight(cos_o));
+    let diffuse = (1.0 - 0.5 * fi) * (1.0 - 0.5 * fo);
+    let rr = 2.0 * roughness * cos_d * cos_d;
+    let retro = rr * (fo + fi + fo * fi * (rr - 1.0));
+    let fss90 = rr / 2.0;
+    let fss = (1.0 + (fss90 - 1.0) * fo) * (1.0 + (fss90 - 1.0) * fi);
+    let flat = 1.25 * (fss * (1.0 / (cos_i + cos_o) - 0.5) + 0.5);
+    diffuse + retro + flatness * (flat - diffuse - retro)
+}
+
+/// The sheen's colour times its Fresnel-like weight at `cos_d`.
+pub(super) fn sheen(base_color: Vec3, sheen_tint: f32, cos_d: f32) -> Vec3 {
+    let colour = Vec3::ONE + sheen_tint * (tint(base_color) - Vec3::ONE);
+    colour * schlick_weight(cos_d.abs())
 }
 
 /// `o` mirrored about the microfacet `h`.
-fn reflect(o: Vec3, h: Vec3) -> Vec3 {
+pub(super) fn reflect(o: Vec3, h: Vec3) -> Vec3 {
     2.0 * o.dot(h) * h - o
 }
 
@@ -403,7 +428,7 @@ fn schlick_weight(cos: f32) -> f32 {
 
 /// Schlick's approximation from normal reflectance `r0`, at the refracted angle where the
 /// light leaves the denser side (Mitsuba's `calc_schlick`).
-fn schlick(r0: Vec3, cos_i: f32, eta: f32) -> Vec3 {
+pub(super) fn schlick(r0: Vec3, cos_i: f32, eta: f32) -> Vec3 {
     let eta_it = if cos_i >= 0.0 { eta } else { 1.0 / eta };
     let weight = if eta_it > 1.0 {
         schlick_weight(cos_i.abs())

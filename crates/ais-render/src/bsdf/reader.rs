@@ -4,8 +4,8 @@
 
 use super::{
     eta_from_specular, named_conductor, Dielectric, Material, Microfacet, MicrofacetKind,
-    PolarizedPlastic, Principled, RoughDielectric, RoughPlastic, SamplingRates, Scattering,
-    SmoothPlastic,
+    PolarizedPlastic, Principled, PrincipledThin, RoughDielectric, RoughPlastic, SamplingRates,
+    Scattering, SmoothPlastic, ThinSamplingRates,
 };
 use crate::error::InputError;
 use crate::scene::{ColourRole, Plugin, Property};
@@ -111,6 +111,22 @@ fn known_properties(kind: &str) -> &'static [&'static str] {
             "diffuse_reflectance_sampling_rate",
             "main_specular_sampling_rate",
             "clearcoat_sampling_rate",
+        ],
+        "principledthin" => &[
+            "base_color",
+            "roughness",
+            "anisotropic",
+            "spec_trans",
+            "diff_trans",
+            "eta",
+            "spec_tint",
+            "sheen",
+            "sheen_tint",
+            "flatness",
+            "specular_reflectance_sampling_rate",
+            "specular_transmittance_sampling_rate",
+            "diffuse_reflectance_sampling_rate",
+            "diffuse_transmittance_sampling_rate",
         ],
         "roughplastic" => &[
             "distribution",
@@ -224,6 +240,7 @@ impl BsdfReader<'_> {
             "roughdielectric" => self.rough_dielectric(),
             "pplastic" => self.polarized_plastic(),
             "principled" => self.principled()?,
+            "principledthin" => self.principled_thin(),
             "twosided" => Material {
                 two_sided: true,
                 ..self.nested()?
@@ -593,14 +610,56 @@ impl BsdfReader<'_> {
         })
     }
 
+    /// Mitsuba's `principledthin` (the same from both sides): every weight in [0, 1] but
+    /// `diff_trans` in [0, 2] (else clamped, with a warning), η 1.5 by default.
+    fn principled_thin(&mut self) -> Material {
+        let defaults = PrincipledThin::default();
+        let mut weight = |name: &str, default: f32| self.unit_weight(name, default);
+        let mut thin = PrincipledThin {
+            base_color: defaults.base_color,
+            roughness: weight("roughness", defaults.roughness),
+            anisotropic: weight("anisotropic", 0.0),
+            spec_trans: weight("spec_trans", 0.0),
+            diffuse_transmission: 0.0,
+            eta: 1.5,
+            spec_tint: weight("spec_tint", 0.0),
+            sheen: weight("sheen", 0.0),
+            sheen_tint: weight("sheen_tint", 0.0),
+            flatness: weight("flatness", 0.0),
+            rates: ThinSamplingRates {
+                specular_reflection: self.rate("specular_reflectance_sampling_rate"),
+                specular_transmission: self.rate("specular_transmittance_sampling_rate"),
+                diffuse_reflection: self.rate("diffuse_reflectance_sampling_rate"),
+                diffuse_transmission: self.rate("diffuse_transmittance_sampling_rate"),
+            },
+        };
+        thin.base_color = self
+            .colour("base_color", defaults.base_color)
+            .min(Vec3::ONE);
+        thin.diffuse_transmission = self.bounded("diff_trans", 0.0, 2.0) / 2.0;
+        thin.eta = self.positive("eta", 1.5);
+        Material {
+            scattering: Scattering::PrincipledThin(thin),
+            two_sided: true,
+        }
+    }
+
     /// A float property meant to lie in [0, 1]: clamped there, with a warning if outside;
     /// `default` with a warning if it is not a finite number.
     fn unit_weight(&mut self, name: &str, default: f32) -> f32 {
+        self.bounded(name, default, 1.0)
+    }
+
+    /// A float property meant to lie in [0, `upper`]: clamped there, with a warning if
+    /// outside; `default` with a warning if it is not a finite number.
+    fn bounded(&mut self, name: &str, default: f32, upper: f64) -> f32 {
         match self.plugin.float(name, default as f64) {
-            Ok(v) if (0.0..=1.0).contains(&v) => v as f32,
+            Ok(v) if (0.0..=upper).contains(&v) => v as f32,
             Ok(v) if v.is_finite() => {
-                self.warn(format!("\"{name}\" = {v} lies outside [0, 1]; clamped"));
-                v.clamp(0.0, 1.0) as f32
+                self.warn(format!(
+                    "\"{name}\" = {v} lies outside [0, {upper}]; clamped"
+                ));
+                v.clamp(0.0, upper) as f32
             }
             Ok(v) => {
                 self.warn(format!("\"{name}\" = {v} is not a number; using {default}"));
