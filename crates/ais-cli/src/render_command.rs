@@ -288,10 +288,15 @@ fn print_summary(
     if let Some([x, y, w, h]) = args.crop {
         println!("crop         {w}×{h} pixels from ({x}, {y})");
     }
+    let geometry = &world.geometry;
+    let instances = match geometry.instance_count() {
+        0 => String::new(),
+        n => format!(", {n} of them instances of shape groups, each group stored once"),
+    };
     println!(
-        "triangles    {} ({} primitives)",
-        world.geometry.triangle_count(),
-        world.geometry.primitive_count()
+        "triangles    {} ({} primitives{instances})",
+        geometry.triangle_count(),
+        geometry.primitive_count()
     );
     println!(
         "BVH build    {:.3} s ({})",

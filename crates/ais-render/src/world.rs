@@ -3,7 +3,9 @@
 use crate::bsdf::{read_surface, Material, Surface, TextureScene};
 use crate::camera::Camera;
 use crate::error::InputError;
-use crate::geometry::{Geometry, ShapeGeometry, ShapeInput, Triangle};
+use crate::geometry::{
+    Geometry, InstanceInput, SceneShapes, ShapeGeometry, ShapeGroupInput, ShapeInput, Triangle,
+};
 use crate::lights::reader::{refuse_nested, scene_emitters, spectrum_property};
 use crate::lights::{AreaLight, AreaShape, Emitters, Lights, MeshEmitter, Rectangle};
 use crate::mesh::{load_mesh, validate, TriangleMesh};
@@ -265,18 +267,31 @@ impl World {
     pub fn from_description(description: SceneDescription) -> Result<Self, InputError> {
         let mut warnings = description.warnings.clone();
         let file = description.file.clone();
-        let mut inputs = Vec::with_capacity(description.shapes.len());
         let mut area_lights = Vec::new();
         let mut surfaces = ShapeSurfaces::default();
-        for (index, shape) in description.shapes.iter().enumerate() {
-            surfaces.add(&description, shape, &mut warnings)?;
-            let built = build_shape(&description, shape, index as u32, &mut warnings)?;
-            check_attributes(&file, shape, &built.input, &surfaces.per_shape[index])?;
-            inputs.push(built.input);
-            area_lights.extend(built.light);
+        // The scene's shapes, then each group's (in its own frame), numbered in that order.
+        let grouped = (description.shape_groups.iter()).map(|group| group.shapes.iter());
+        let placements = std::iter::once(description.shapes.iter()).chain(grouped);
+        let mut built_sets: Vec<Vec<ShapeInput>> = Vec::new();
+        let mut index = 0u32;
+        for shapes in placements {
+            let mut inputs = Vec::with_capacity(shapes.len());
+            for shape in shapes {
+                surfaces.add(&description, shape, &mut warnings)?;
+                let built = build_shape(&description, shape, index, &mut warnings)?;
+                check_attributes(
+                    &file,
+                    shape,
+                    &built.input,
+                    &surfaces.per_shape[index as usize],
+                )?;
+                inputs.push(built.input);
+                area_lights.extend(built.light);
+                index += 1;
+            }
+            built_sets.push(inputs);
         }
-        let triangles = inputs
-            .iter()
+        let triangles = (built_sets.iter().flatten())
             .map(|input| match &input.geometry {
                 ShapeGeometry::Mesh(mesh) => mesh.triangles.len(),
                 ShapeGeometry::Sphere(_) => 1,
@@ -284,7 +299,17 @@ impl World {
             .sum();
         crate::limits::check_geometry_memory(triangles)
             .map_err(|message| InputError::new(&file, message))?;
-        let geometry = Geometry::build(inputs);
+        let mut sets = built_sets.into_iter();
+        let geometry = Geometry::build_instanced(SceneShapes {
+            shapes: sets.next().unwrap_or_default(),
+            groups: sets.map(|shapes| ShapeGroupInput { shapes }).collect(),
+            instances: (description.instances.iter())
+                .map(|instance| InstanceInput {
+                    group: instance.group as u32,
+                    to_world: glam::Affine3A::from_mat4(instance.to_world.as_mat4()),
+                })
+                .collect(),
+        });
         let scene = TextureScene {
             file: &file,
             files: &description.files,
@@ -298,7 +323,7 @@ impl World {
             area: area_lights,
             delta,
         };
-        let lights = Lights::new(emitters, description.shapes.len(), radius.max(1e-3) as f64);
+        let lights = Lights::new(emitters, index as usize, radius.max(1e-3) as f64);
         let (width, height) = description.resolution;
         Ok(World {
             geometry,

@@ -246,3 +246,119 @@ fn offset_rays_do_not_hit_the_surface_they_leave() {
     }
     assert!(tested > 10_000);
 }
+
+/// A shape group of random triangles and spheres in the unit box, as shapes.
+fn random_group(rng: &mut Pcg32) -> Vec<ShapeInput> {
+    let mut mesh = TriangleMesh::default();
+    for t in 0..300u32 {
+        let center = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+        for _ in 0..3 {
+            mesh.positions.push(center + random_unit(rng) * 0.1);
+        }
+        mesh.triangles.push([3 * t, 3 * t + 1, 3 * t + 2]);
+    }
+    let mut shapes = vec![ShapeInput {
+        geometry: ShapeGeometry::Mesh(mesh),
+        flip_normals: false,
+        rotation: None,
+    }];
+    for _ in 0..10 {
+        shapes.push(ShapeInput {
+            geometry: ShapeGeometry::Sphere(Sphere {
+                center: Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()),
+                radius: 0.02 + 0.08 * rng.next_f32(),
+            }),
+            flip_normals: false,
+            rotation: None,
+        });
+    }
+    shapes
+}
+
+/// `shape` moved by `to_world` (a rotation, a uniform scale and a translation).
+fn placed(shape: &ShapeInput, to_world: glam::Affine3A) -> ShapeInput {
+    let geometry = match &shape.geometry {
+        ShapeGeometry::Mesh(mesh) => {
+            let mut moved = mesh.clone();
+            for p in &mut moved.positions {
+                *p = to_world.transform_point3(*p);
+            }
+            ShapeGeometry::Mesh(moved)
+        }
+        ShapeGeometry::Sphere(s) => ShapeGeometry::Sphere(Sphere {
+            center: to_world.transform_point3(s.center),
+            radius: s.radius * to_world.transform_vector3(Vec3::X).length(),
+        }),
+    };
+    ShapeInput {
+        geometry,
+        ..shape.clone()
+    }
+}
+
+#[test]
+fn instances_hit_what_copies_of_their_group_hit() {
+    use ais_render::geometry::{InstanceInput, SceneShapes, ShapeGroupInput};
+    let mut rng = Pcg32::new(47, 3);
+    let group = random_group(&mut rng);
+    let placements: Vec<glam::Affine3A> = (0..8)
+        .map(|k| {
+            let axis = random_unit(&mut rng);
+            glam::Affine3A::from_scale_rotation_translation(
+                Vec3::splat(1.0 + 2.0 * rng.next_f32()),
+                glam::Quat::from_axis_angle(axis, 6.0 * rng.next_f32()),
+                Vec3::new((k % 4) as f32 * 3.0, (k / 4) as f32 * 3.0, rng.next_f32()),
+            )
+        })
+        .collect();
+    let instanced = Geometry::build_instanced(SceneShapes {
+        shapes: Vec::new(),
+        groups: vec![ShapeGroupInput {
+            shapes: group.clone(),
+        }],
+        instances: (placements.iter())
+            .map(|&to_world| InstanceInput { group: 0, to_world })
+            .collect(),
+    });
+    let copies = Geometry::build(
+        (placements.iter())
+            .flat_map(|&to_world| group.iter().map(move |shape| placed(shape, to_world)))
+            .collect(),
+    );
+    assert_eq!(instanced.instance_count(), 8);
+    assert_eq!(instanced.triangle_count(), 300, "the group is stored once");
+    let mut hits = 0;
+    for i in 0..4000 {
+        let origin = Vec3::new(
+            rng.next_f32() * 12.0,
+            rng.next_f32() * 7.0,
+            rng.next_f32() * 4.0,
+        ) - Vec3::ONE;
+        let mut ray = Ray::new(origin, random_unit(&mut rng));
+        if i % 3 == 0 {
+            ray.t_max = 4.0 * rng.next_f32();
+        }
+        let (ours, copied) = (instanced.intersect(&ray), copies.intersect(&ray));
+        match (ours, copied) {
+            (Some(a), Some(b)) => {
+                assert!(
+                    (a.t - b.t).abs() <= 1e-4 * b.t.max(1.0),
+                    "ray {i}: {} vs {}",
+                    a.t,
+                    b.t
+                );
+                assert!((a.point - b.point).length() <= 1e-3, "ray {i}");
+                let normals = a.geometric_normal.dot(b.geometric_normal);
+                assert!(normals > 0.999, "ray {i}: normals {normals}");
+                assert_eq!(a.shape == 0, b.shape % 11 == 0, "ray {i}: mesh or sphere");
+                hits += 1;
+            }
+            (None, None) => {}
+            (a, b) => panic!("ray {i}: instances {a:?} vs copies {b:?}"),
+        }
+        assert_eq!(instanced.occluded(&ray), copied.is_some(), "ray {i}");
+        let brute = instanced.intersect_brute_force(&ray).map(|h| h.t);
+        assert_eq!(brute.is_some(), copied.is_some(), "ray {i}: brute force");
+    }
+    assert!(hits > 300, "the test must exercise hits: {hits}");
+}

@@ -676,7 +676,7 @@ fn a_missing_mesh_attribute_is_refused_with_those_there() {
 }
 
 #[test]
-fn instances_copy_their_group_under_their_transform() {
+fn instances_place_their_group_under_their_transform() {
     let text = r#"<scene version="3.0.0">
         <shape type="shapegroup" id="g">
             <shape type="cube"><transform name="to_world"><translate x="1"/></transform></shape>
@@ -685,23 +685,31 @@ fn instances_copy_their_group_under_their_transform() {
         <shape type="instance"><ref id="g"/><transform name="to_world"><scale value="2"/></transform></shape>
         <shape type="instance"><ref id="g"/></shape></scene>"#;
     let scene = parse(text).unwrap();
+    assert!(scene.shapes.is_empty(), "the group itself renders nothing");
+    assert_eq!(scene.shape_groups.len(), 1);
+    assert_eq!(scene.shape_groups[0].shapes.len(), 2);
+    assert_eq!(scene.instances.len(), 2);
+    assert_eq!(scene.instances[0].group, 0);
+    let moved = scene.instances[0].to_world.transform_point3(DVec3::X);
+    assert_eq!(moved, DVec3::new(2.0, 0.0, 0.0));
+    let world = ais_render::world::World::from_description(scene).unwrap();
+    assert_eq!(world.geometry.instance_count(), 2);
     assert_eq!(
-        scene.shapes.len(),
-        4,
-        "two shapes per instance, none for the group"
+        world.geometry.triangle_count(),
+        12,
+        "the cube is stored once"
     );
-    let moved = scene.shapes[0].to_world.transform_point3(DVec3::ZERO);
     assert_eq!(
-        moved,
-        DVec3::new(2.0, 0.0, 0.0),
-        "the instance's transform after the shape's"
+        world.surfaces.len(),
+        2,
+        "one surface per shape of the group"
     );
+    let singular = r#"<scene version="3.0.0">
+        <shape type="shapegroup" id="g"><shape type="sphere"/></shape>
+        <shape type="instance"><ref id="g"/><transform name="to_world"><scale x="0"/></transform></shape></scene>"#;
+    let error = parse(singular).unwrap_err().to_string();
     assert!(
-        scene
-            .warnings
-            .iter()
-            .filter(|w| w.contains("instances are copied"))
-            .count()
-            == 1
+        error.contains(":3:") && error.contains("singular"),
+        "{error}"
     );
 }

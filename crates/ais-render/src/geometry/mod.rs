@@ -1,13 +1,17 @@
-//! Scene geometry: triangle meshes and spheres in an obvhs CWBVH (or, with the cargo
-//! feature `embree`, in Intel Embree 3), with closest-hit and occlusion queries.
+//! Scene geometry: triangle meshes, spheres and instances of shape groups in an obvhs
+//! CWBVH (or, with the cargo feature `embree` and no instances, in Intel Embree 3), with
+//! closest-hit and occlusion queries.
 
 mod basis;
 #[cfg(feature = "embree")]
 mod embree;
+mod instances;
 mod primitive;
 mod ray;
 
 pub use basis::basis;
+use instances::{GroupGeometry, Instance};
+pub use instances::{InstanceInput, SceneShapes, ShapeGroupInput};
 use primitive::Packed;
 pub use primitive::{Primitive, Sphere, Triangle};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
@@ -59,10 +63,13 @@ pub struct Hit {
     pub dp_du: Vec3,
     /// How the point moves with v (∂p/∂v), likewise.
     pub dp_dv: Vec3,
-    /// The primitive hit (its index among the geometry's primitives).
+    /// The primitive hit (its index among the geometry's primitives, or among its shape
+    /// group's when `instance` is set).
     pub primitive: u32,
     /// Barycentric coordinates of the point on a triangle (zero on a sphere).
     pub barycentrics: Vec2,
+    /// The instance of a shape group that was hit, if any (by index).
+    pub instance: Option<u32>,
 }
 
 /// Per-mesh data needed to shade a triangle hit.
@@ -84,9 +91,16 @@ pub struct Geometry {
     /// For each packed primitive: its shape, and for a triangle its mesh and index there.
     sources: Vec<PrimitiveSource>,
     meshes: Vec<MeshShading>,
+    /// Per shape added (its slot): the shape's index in the scene.
+    shape_ids: Vec<u32>,
+    /// Per slot: whether the shape's normals flip.
     shape_flips: Vec<bool>,
-    /// Per shape, the rotation of a rotated sphere (world to its own frame).
+    /// Per slot, the rotation of a rotated sphere (world to its own frame).
     sphere_rotations: Vec<Option<glam::Mat3>>,
+    /// The shape groups that instances place, each in its own BVH.
+    groups: Vec<GroupGeometry>,
+    /// The instances (primitives of this geometry's BVH).
+    instances: Vec<Instance>,
     accelerator: Option<Accelerator>,
     triangle_count: usize,
     /// Centre and radius of a sphere around everything.
@@ -106,6 +120,7 @@ enum Accelerator {
 /// Where a primitive came from: what shading a hit on it needs.
 #[derive(Clone, Copy, Debug)]
 struct PrimitiveSource {
+    /// The shape's slot (see `Geometry::shape_ids`).
     shape: u32,
     /// The triangle's mesh (unused for a sphere).
     mesh: u32,
@@ -113,33 +128,121 @@ struct PrimitiveSource {
     index: u32,
 }
 
+/// The closest hit found so far in a traversal.
+enum Closest {
+    /// A primitive of this geometry, to be shaded.
+    Primitive {
+        index: usize,
+        t: f32,
+        barycentrics: Vec2,
+    },
+    /// A primitive of an instance, already shaded in world space.
+    Instance(Hit),
+}
+
+impl Closest {
+    fn t(&self) -> f32 {
+        match self {
+            Closest::Primitive { t, .. } => *t,
+            Closest::Instance(hit) => hit.t,
+        }
+    }
+}
+
 impl Geometry {
     /// Builds the BVH over all shapes.
     pub fn build(shapes: Vec<ShapeInput>) -> Self {
+        Self::build_instanced(SceneShapes {
+            shapes,
+            ..SceneShapes::default()
+        })
+    }
+
+    /// Builds the BVH over the scene's shapes and the instances of its shape groups: each
+    /// group once, in a BVH of its own, whatever the number of its instances. Shapes are
+    /// numbered in order, the scene's first, then the groups' (group after group). An
+    /// instance whose transform cannot be inverted is left out.
+    pub fn build_instanced(scene: SceneShapes) -> Self {
         let started = Instant::now();
-        let mut geometry = Geometry {
-            primitives: Vec::new(),
-            packed: Vec::new(),
-            sources: Vec::new(),
-            meshes: Vec::new(),
-            shape_flips: Vec::new(),
-            sphere_rotations: Vec::new(),
-            accelerator: None,
-            triangle_count: 0,
-            bounds: (Vec3::ZERO, 0.0),
-            build_time: Duration::ZERO,
-        };
-        for (shape_index, shape) in shapes.into_iter().enumerate() {
-            geometry.add(shape_index as u32, shape);
+        let mut geometry = Geometry::empty();
+        let mut next_shape = 0u32;
+        for shape in scene.shapes {
+            geometry.add(next_shape, shape);
+            next_shape += 1;
         }
-        geometry.bounds = bounding_sphere(&geometry.primitives);
-        geometry.build_bvh();
+        for group in scene.groups {
+            let mut inner = Geometry::empty();
+            for shape in group.shapes {
+                inner.add(next_shape, shape);
+                next_shape += 1;
+            }
+            let bounds = primitive_bounds(&inner.primitives);
+            geometry.triangle_count += inner.triangle_count;
+            inner.finish();
+            geometry.groups.push(GroupGeometry {
+                geometry: inner,
+                bounds,
+            });
+        }
+        for input in &scene.instances {
+            let Some(group) = geometry.groups.get(input.group as usize) else {
+                continue;
+            };
+            let Some(instance) = Instance::new(input) else {
+                continue;
+            };
+            let bounds = instance.world_bounds(&group.bounds);
+            let index = geometry.instances.len() as u32;
+            geometry.instances.push(instance);
+            geometry
+                .primitives
+                .push(Primitive::Instance { index, bounds });
+            geometry.sources.push(PrimitiveSource {
+                shape: 0,
+                mesh: 0,
+                index,
+            });
+        }
+        geometry.finish();
         geometry.build_time = started.elapsed();
         geometry
     }
 
-    /// Appends a shape's primitives.
+    /// A geometry of nothing.
+    fn empty() -> Self {
+        Geometry {
+            primitives: Vec::new(),
+            packed: Vec::new(),
+            sources: Vec::new(),
+            meshes: Vec::new(),
+            shape_ids: Vec::new(),
+            shape_flips: Vec::new(),
+            sphere_rotations: Vec::new(),
+            groups: Vec::new(),
+            instances: Vec::new(),
+            accelerator: None,
+            triangle_count: 0,
+            bounds: (Vec3::ZERO, 0.0),
+            build_time: Duration::ZERO,
+        }
+    }
+
+    /// Bounds the primitives added and builds the accelerator over them.
+    fn finish(&mut self) {
+        let bounds = primitive_bounds(&self.primitives);
+        self.bounds = if bounds.valid() {
+            let centre = Vec3::from(bounds.center());
+            (centre, bounds.diagonal().length() * 0.5)
+        } else {
+            (Vec3::ZERO, 0.0)
+        };
+        self.build_bvh();
+    }
+
+    /// Appends a shape's primitives; the shape is number `shape_index` in the scene.
     fn add(&mut self, shape_index: u32, shape: ShapeInput) {
+        let slot = self.shape_ids.len() as u32;
+        self.shape_ids.push(shape_index);
         self.shape_flips.push(shape.flip_normals);
         self.sphere_rotations
             .push(shape.rotation.map(|r| r.transpose()));
@@ -147,7 +250,7 @@ impl Geometry {
             ShapeGeometry::Sphere(sphere) => {
                 self.primitives.push(Primitive::Sphere(sphere));
                 self.sources.push(PrimitiveSource {
-                    shape: shape_index,
+                    shape: slot,
                     mesh: 0,
                     index: 0,
                 });
@@ -165,7 +268,7 @@ impl Geometry {
                         index: index as u32,
                     }));
                     self.sources.push(PrimitiveSource {
-                        shape: shape_index,
+                        shape: slot,
                         mesh: mesh_index,
                         index: index as u32,
                     });
@@ -185,7 +288,7 @@ impl Geometry {
     /// CWBVH.
     fn build_bvh(&mut self) {
         #[cfg(feature = "embree")]
-        if self.build_embree() {
+        if self.instances.is_empty() && self.build_embree() {
             return;
         }
         self.build_cwbvh();
@@ -244,14 +347,19 @@ impl Geometry {
         }
     }
 
-    /// Number of triangles.
+    /// Number of triangles, each instanced group's counted once.
     pub fn triangle_count(&self) -> usize {
         self.triangle_count
     }
 
-    /// Number of primitives (triangles and spheres).
+    /// Number of primitives in the scene's BVH (triangles, spheres and instances).
     pub fn primitive_count(&self) -> usize {
         self.packed.len()
+    }
+
+    /// Number of instances of shape groups.
+    pub fn instance_count(&self) -> usize {
+        self.instances.len()
     }
 
     /// Centre and radius of a sphere enclosing every primitive (zero for an empty scene).
@@ -264,29 +372,87 @@ impl Geometry {
         self.build_time
     }
 
+    /// The hit of `ray` on primitive `index` before `t_max`, if any.
     #[inline]
-    fn intersect_primitive(&self, index: usize, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
-        self.packed[index].intersect(ray, t_max)
+    fn intersect_primitive(&self, index: usize, ray: &Ray, t_max: f32) -> Option<Closest> {
+        match self.packed[index] {
+            Packed::Instance(k) => {
+                let instance = &self.instances[k as usize];
+                let group = &self.groups[instance.group as usize].geometry;
+                let hit = instance.intersect(group, ray, t_max)?;
+                Some(Closest::Instance(Hit {
+                    instance: Some(k),
+                    ..hit
+                }))
+            }
+            packed => packed
+                .intersect(ray, t_max)
+                .map(|(t, barycentrics)| Closest::Primitive {
+                    index,
+                    t,
+                    barycentrics,
+                }),
+        }
+    }
+
+    /// The distance at which primitive `index` blocks `ray` before `t_max` (infinity: it
+    /// does not; an instance that blocks it answers 0).
+    #[inline]
+    fn blocking_distance(&self, index: usize, ray: &Ray, t_max: f32) -> f32 {
+        match self.packed[index] {
+            Packed::Instance(k) => {
+                let instance = &self.instances[k as usize];
+                let group = &self.groups[instance.group as usize].geometry;
+                if instance.occludes(group, ray, t_max) {
+                    0.0
+                } else {
+                    f32::INFINITY
+                }
+            }
+            packed => packed
+                .intersect(ray, t_max)
+                .map_or(f32::INFINITY, |(t, _)| t),
+        }
     }
 
     /// The closest hit along the ray, if any.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
-        let (index, t, barycentrics) = match self.accelerator.as_ref()? {
+        let closest = match self.accelerator.as_ref()? {
             Accelerator::Cwbvh(bvh) => self.cwbvh_closest(bvh, ray)?,
             #[cfg(feature = "embree")]
-            Accelerator::Embree(scene) => scene.intersect(ray)?,
+            Accelerator::Embree(scene) => {
+                let (index, t, barycentrics) = scene.intersect(ray)?;
+                Closest::Primitive {
+                    index,
+                    t,
+                    barycentrics,
+                }
+            }
         };
-        Some(self.shade(index, ray, t, barycentrics))
+        Some(self.resolve(closest, ray))
     }
 
-    /// The CWBVH's closest primitive along the ray: its index, distance and barycentrics.
-    fn cwbvh_closest(&self, bvh: &CwBvh, ray: &Ray) -> Option<(usize, f32, Vec2)> {
-        let mut best: Option<(usize, f32, Vec2)> = None;
+    /// The hit that `closest` stands for.
+    fn resolve(&self, closest: Closest, ray: &Ray) -> Hit {
+        match closest {
+            Closest::Primitive {
+                index,
+                t,
+                barycentrics,
+            } => self.shade(index, ray, t, barycentrics),
+            Closest::Instance(hit) => hit,
+        }
+    }
+
+    /// The CWBVH's closest primitive along the ray.
+    fn cwbvh_closest(&self, bvh: &CwBvh, ray: &Ray) -> Option<Closest> {
+        let mut best: Option<Closest> = None;
         let mut hit = obvhs::ray::RayHit::none();
         bvh.ray_traverse(ray.to_bvh(ray.t_max), &mut hit, |r, id| {
             match self.intersect_primitive(id, ray, r.tmax) {
-                Some((t, barycentrics)) => {
-                    best = Some((id, t, barycentrics));
+                Some(closest) => {
+                    let t = closest.t();
+                    best = Some(closest);
                     t
                 }
                 None => f32::INFINITY,
@@ -297,26 +463,24 @@ impl Geometry {
 
     /// The closest hit by testing every primitive: the reference the BVH is tested against.
     pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
-        let mut best: Option<(usize, f32, Vec2)> = None;
+        let mut best: Option<Closest> = None;
         for index in 0..self.packed.len() {
-            let t_max = best.map_or(ray.t_max, |b| b.1);
-            if let Some((t, barycentrics)) = self.intersect_primitive(index, ray, t_max) {
-                best = Some((index, t, barycentrics));
+            let t_max = best.as_ref().map_or(ray.t_max, Closest::t);
+            if let Some(closest) = self.intersect_primitive(index, ray, t_max) {
+                best = Some(closest);
             }
         }
-        best.map(|(index, t, barycentrics)| self.shade(index, ray, t, barycentrics))
+        best.map(|closest| self.resolve(closest, ray))
     }
 
     /// Whether anything blocks the ray before `t_max` (any-hit query).
     pub fn occluded(&self, ray: &Ray) -> bool {
         match &self.accelerator {
             None => false,
-            Some(Accelerator::Cwbvh(bvh)) => {
-                !bvh.ray_traverse_miss(ray.to_bvh(ray.t_max), |r, id| {
-                    self.intersect_primitive(id, ray, r.tmax)
-                        .map_or(f32::INFINITY, |(t, _)| t)
-                })
-            }
+            Some(Accelerator::Cwbvh(bvh)) => !bvh
+                .ray_traverse_miss(ray.to_bvh(ray.t_max), |r, id| {
+                    self.blocking_distance(id, ray, r.tmax)
+                }),
             #[cfg(feature = "embree")]
             Some(Accelerator::Embree(scene)) => scene.occluded(ray),
         }
@@ -331,6 +495,8 @@ impl Geometry {
             1.0
         };
         let (geometric_normal, shading_normal, uv, [dp_du, dp_dv]) = match &self.packed[index] {
+            // Instances are shaded by their group (see `intersect_primitive`).
+            Packed::Instance(_) => (Vec3::Z, Vec3::Z, Vec2::ZERO, [Vec3::X, Vec3::Y]),
             Packed::Sphere(s) => {
                 let outward = (point - s.center).normalize();
                 // Texture coordinates and tangents in the sphere's own frame.
@@ -355,12 +521,13 @@ impl Geometry {
             point,
             geometric_normal,
             shading_normal,
-            shape: source.shape,
+            shape: self.shape_ids[source.shape as usize],
             uv,
             dp_du,
             dp_dv,
             primitive: index as u32,
             barycentrics,
+            instance: None,
         }
     }
 
@@ -373,6 +540,13 @@ impl Geometry {
 
     /// Where the mesh attributes of `hit`'s mesh are looked up (None on a sphere).
     pub fn attribute_site(&self, hit: &Hit) -> Option<AttributeSite<'_>> {
+        if let Some(k) = hit.instance {
+            let group = &self.groups[self.instances[k as usize].group as usize].geometry;
+            return group.attribute_site(&Hit {
+                instance: None,
+                ..*hit
+            });
+        }
         let source = self.sources[hit.primitive as usize];
         if !matches!(self.packed[hit.primitive as usize], Packed::Triangle(_)) {
             return None;
@@ -452,26 +626,12 @@ fn sphere_partials(outward: Vec3, radius: f32) -> [Vec3; 2] {
     [dp_du, dp_dv * (std::f32::consts::PI * radius)]
 }
 
-/// Centre and radius of a sphere enclosing every primitive (zero for none).
-fn bounding_sphere(primitives: &[Primitive]) -> (Vec3, f32) {
-    let mut low = Vec3::splat(f32::INFINITY);
-    let mut high = Vec3::splat(f32::NEG_INFINITY);
-    for primitive in primitives {
-        match primitive {
-            Primitive::Triangle(t) => {
-                for v in t.vertices {
-                    low = low.min(v);
-                    high = high.max(v);
-                }
-            }
-            Primitive::Sphere(s) => {
-                low = low.min(s.center - s.radius);
-                high = high.max(s.center + s.radius);
-            }
-        }
-    }
-    if low.x > high.x {
-        return (Vec3::ZERO, 0.0);
-    }
-    ((low + high) * 0.5, (high - low).length() * 0.5)
+/// The box around `primitives` (empty for none).
+fn primitive_bounds(primitives: &[Primitive]) -> obvhs::aabb::Aabb {
+    use obvhs::Boundable;
+    primitives
+        .iter()
+        .fold(obvhs::aabb::Aabb::empty(), |bounds, p| {
+            bounds.union(&p.aabb())
+        })
 }

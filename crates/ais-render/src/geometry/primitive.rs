@@ -1,4 +1,5 @@
-//! The primitives the BVH holds: triangles and spheres, with exact intersection.
+//! The primitives the BVH holds: triangles and spheres, with exact intersection, and
+//! instances of shape groups (intersected by [`super::Geometry`], which holds the groups).
 
 use super::ray::Ray;
 use glam::{Vec2, Vec3};
@@ -30,6 +31,13 @@ pub enum Primitive {
     Triangle(Triangle),
     /// A sphere.
     Sphere(Sphere),
+    /// An instance of a shape group: its index, and its box in world space.
+    Instance {
+        /// The instance's index.
+        index: u32,
+        /// Its bounds.
+        bounds: obvhs::aabb::Aabb,
+    },
 }
 
 /// A primitive as traversal tests it, in the BVH's order: a triangle by its first vertex and
@@ -41,6 +49,8 @@ pub(crate) enum Packed {
     Triangle([Vec3; 3]),
     /// A sphere.
     Sphere(Sphere),
+    /// An instance of a shape group, by index (its geometry lives in [`super::Geometry`]).
+    Instance(u32),
 }
 
 impl Packed {
@@ -52,15 +62,18 @@ impl Packed {
                 Packed::Triangle([v0, v1 - v0, v2 - v0])
             }
             Primitive::Sphere(s) => Packed::Sphere(*s),
+            Primitive::Instance { index, .. } => Packed::Instance(*index),
         }
     }
 
-    /// The distance and barycentrics (zero for a sphere) of the hit, if within the ray.
+    /// The distance and barycentrics (zero for a sphere) of the hit, if within the ray (an
+    /// instance is not tested here: see [`super::Geometry`]).
     #[inline]
     pub(crate) fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
         match self {
             Packed::Triangle([v0, e1, e2]) => moller_trumbore(*v0, *e1, *e2, ray, t_max),
             Packed::Sphere(s) => s.intersect(ray, t_max).map(|t| (t, Vec2::ZERO)),
+            Packed::Instance(_) => None,
         }
     }
 }
@@ -145,6 +158,7 @@ impl obvhs::Boundable for Primitive {
                 let r = glam::Vec3A::splat(s.radius);
                 obvhs::aabb::Aabb::new(c - r, c + r)
             }
+            Primitive::Instance { bounds, .. } => *bounds,
         }
     }
 }

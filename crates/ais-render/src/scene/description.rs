@@ -163,10 +163,12 @@ pub struct SceneDescription {
     pub filter: ReconstructionFilter,
     /// The sampler's `sample_count` (samples per pixel).
     pub sample_count: u32,
-    /// Shapes (instances' copies included).
+    /// Shapes placed in the scene itself.
     pub shapes: Vec<ShapeDescription>,
-    /// Shape groups, which instances copy.
+    /// Shape groups, which instances place.
     pub shape_groups: Vec<super::instancing::ShapeGroup>,
+    /// Instances of the shape groups.
+    pub instances: Vec<super::instancing::InstanceDescription>,
     /// BSDFs (top-level with ids, and those nested in shapes), carried for the shading code.
     pub bsdfs: Vec<Plugin>,
     /// Top-level textures, which BSDFs reference by id.
@@ -204,6 +206,7 @@ impl SceneDescription {
             sample_count: 4,
             shapes: Vec::new(),
             shape_groups: Vec::new(),
+            instances: Vec::new(),
             bsdfs: Vec::new(),
             textures: Vec::new(),
             referable: Vec::new(),
@@ -308,8 +311,8 @@ fn read_top_level(
             super::instancing::read_shape_group(path, files, plugin, scene).map_err(at)?
         }
         "shape" if plugin.kind == "instance" => {
-            let shapes = super::instancing::instance_shapes(path, plugin, scene).map_err(at)?;
-            scene.shapes.extend(shapes);
+            let instance = super::instancing::read_instance(path, plugin, scene).map_err(at)?;
+            scene.instances.push(instance);
         }
         "shape" => {
             let shape = read_shape(path, files, plugin, scene).map_err(at)?;

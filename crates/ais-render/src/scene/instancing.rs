@@ -1,13 +1,11 @@
 //! Mitsuba's `shapegroup` and `instance`: the shapes of a group are read once, where the
-//! group is declared (it renders nothing itself), and each `instance` adds them to the scene
-//! under its own `to_world`, composed with theirs.
-//!
-//! The instances are copies: each one's shapes enter the BVH (and their mesh files are read)
-//! again, so memory and build time grow with the number of instances. A two-level BVH that
-//! shares a group's geometry is not built yet; the scene warns once.
+//! group is declared (it renders nothing itself), and each `instance` places the group in
+//! the scene under its own `to_world`, composed after theirs. The group's geometry is built
+//! once and shared by its instances (see the geometry's instancing).
 
 use super::description::{read_shape, SceneDescription, ShapeDescription};
 use super::{FileResolver, Plugin};
+use glam::DMat4;
 use std::path::Path;
 
 /// A `shapegroup`: its id and shapes.
@@ -17,6 +15,17 @@ pub struct ShapeGroup {
     pub id: String,
     /// Its shapes, in the group's frame.
     pub shapes: Vec<ShapeDescription>,
+}
+
+/// An `instance`: a shape group placed in the scene.
+#[derive(Clone, Debug, PartialEq)]
+pub struct InstanceDescription {
+    /// The group (its index in [`SceneDescription::shape_groups`]).
+    pub group: usize,
+    /// Group frame → world.
+    pub to_world: DMat4,
+    /// Line of the `<shape type="instance">` element.
+    pub line: u32,
 }
 
 /// Reads a `shapegroup` (its nested shapes; emitters are refused, as instanced emitters are
@@ -57,22 +66,24 @@ pub(super) fn read_shape_group(
     Ok(())
 }
 
-/// The shapes an `instance` adds: those of the group it references, under its `to_world`.
-pub(super) fn instance_shapes(
+/// An `instance`: the group it references (declared before it) and its `to_world`.
+pub(super) fn read_instance(
     path: &Path,
     instance: &Plugin,
     scene: &mut SceneDescription,
-) -> Result<Vec<ShapeDescription>, (u32, String)> {
+) -> Result<InstanceDescription, (u32, String)> {
     let [(_, id, line)] = instance.references.as_slice() else {
         return Err((
             instance.line,
             "an instance references exactly one shapegroup".into(),
         ));
     };
-    let group = (scene.shape_groups.iter()).find(|g| &g.id == id).ok_or((
-        *line,
-        format!("no shapegroup with id \"{id}\" (declare it before its instances)"),
-    ))?;
+    let group = (scene.shape_groups.iter())
+        .position(|g| &g.id == id)
+        .ok_or((
+            *line,
+            format!("no shapegroup with id \"{id}\" (declare it before its instances)"),
+        ))?;
     if let Some(child) = instance.children.first() {
         return Err((
             child.line,
@@ -80,24 +91,10 @@ pub(super) fn instance_shapes(
         ));
     }
     let to_world = instance.transform("to_world")?;
-    let shapes = (group.shapes.iter())
-        .map(|shape| ShapeDescription {
-            to_world: to_world * shape.to_world,
-            ..shape.clone()
-        })
-        .collect();
-    if !scene
-        .warnings
-        .iter()
-        .any(|w| w.contains("instances are copied"))
-    {
-        scene.warnings.push(format!(
-            "{}:{}: instances are copied into the scene (ais has no two-level BVH yet): memory \
-             and build time grow with their number",
-            path.display(),
-            instance.line
-        ));
-    }
     super::description::warn_unknown(path, instance, &["to_world"], &mut scene.warnings);
-    Ok(shapes)
+    Ok(InstanceDescription {
+        group,
+        to_world,
+        line: instance.line,
+    })
 }

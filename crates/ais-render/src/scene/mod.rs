@@ -14,7 +14,7 @@ pub use description::{
 };
 pub(crate) use description::{read_fov, warn_unknown};
 pub use file_resolver::FileResolver;
-pub use instancing::ShapeGroup;
+pub use instancing::{InstanceDescription, ShapeGroup};
 pub use properties::{LocatedProperty, Plugin, Property};
 pub use spectrum::{ColourRole, SampledSpectrum, Spectrum};
 pub use xml::look_at;
