@@ -1,7 +1,8 @@
 //! Textures on a BSDF's parameters, as Mitsuba accepts them: the albedo (`reflectance` of
 //! `diffuse`, `diffuse_reflectance` of the plastics), `specular_reflectance` (conductors,
 //! plastics, dielectrics), `specular_transmittance` (dielectrics) and the roughness `alpha`
-//! (`roughconductor`, `roughdielectric`), also inside `twosided`, as a nested `<texture>` or
+//! (`roughconductor`, `roughdielectric`), a conductor's `eta` and `k`, the principled BSDFs'
+//! weights, also inside `twosided`, as a nested `<texture>` or
 //! a `<ref>` to a top-level one. The material read by [`super::Material::from_plugin`] keeps
 //! the constant default; [`super::Material::set_parameter`] puts a texture's value at a hit
 //! in its place.
@@ -43,6 +44,10 @@ pub enum TexturedParameter {
     RoughnessV,
     /// A weight of the principled BSDF (one channel).
     Principled(PrincipledWeight),
+    /// A conductor's index of refraction, real part (colour, unbounded).
+    ConductorEta,
+    /// A conductor's index of refraction, imaginary part (colour, unbounded).
+    ConductorK,
 }
 
 /// The principled BSDF's one-channel parameters that textures may give.
@@ -100,7 +105,11 @@ pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, Textur
             ("diffuse_reflectance", Albedo),
             ("specular_reflectance", SpecularReflectance),
         ],
-        "conductor" => &[("specular_reflectance", SpecularReflectance)],
+        "conductor" => &[
+            ("specular_reflectance", SpecularReflectance),
+            ("eta", ConductorEta),
+            ("k", ConductorK),
+        ],
         "pplastic" => &[
             ("diffuse_reflectance", Albedo),
             ("specular_reflectance", SpecularReflectance),
@@ -110,6 +119,8 @@ pub(super) fn textured_parameters(kind: &str) -> &'static [(&'static str, Textur
         ],
         "roughconductor" => &[
             ("specular_reflectance", SpecularReflectance),
+            ("eta", ConductorEta),
+            ("k", ConductorK),
             ("alpha", Roughness),
             ("alpha_u", RoughnessU),
             ("alpha_v", RoughnessV),
@@ -266,6 +277,14 @@ impl Material {
             (Scattering::RoughDielectric(d), Roughness | RoughnessU | RoughnessV) => {
                 d.microfacet = with_roughness(d.microfacet, parameter, value.x)
             }
+            (
+                Scattering::RoughConductor { eta, .. } | Scattering::Conductor { eta, .. },
+                ConductorEta,
+            ) => *eta = colour,
+            (
+                Scattering::RoughConductor { k, .. } | Scattering::Conductor { k, .. },
+                ConductorK,
+            ) => *k = colour,
             (Scattering::Principled(p), Albedo) => p.base_color = albedo,
             (Scattering::Principled(p), Principled(weight)) => {
                 set_principled_weight(p, weight, value.x.clamp(0.0, 1.0))

@@ -391,7 +391,18 @@ impl BsdfReader<'_> {
     /// A conductor's complex index of refraction: `eta` and `k`, or a named `material`.
     fn conductor_ior(&mut self) -> (Vec3, Vec3) {
         let plugin = self.plugin;
-        if plugin.properties.contains_key("eta") || plugin.properties.contains_key("k") {
+        let given = |name: &str| {
+            plugin.properties.contains_key(name)
+                || plugin
+                    .children
+                    .iter()
+                    .any(|c| c.name.as_deref() == Some(name))
+                || plugin
+                    .references
+                    .iter()
+                    .any(|r| r.0.as_deref() == Some(name))
+        };
+        if given("eta") || given("k") {
             return (self.colour("eta", Vec3::ZERO), self.colour("k", Vec3::ONE));
         }
         match plugin.string("material") {
