@@ -1,14 +1,12 @@
 //! Mitsuba's built-in shapes as world-space geometry: rectangles and cubes as exact
-//! triangles, disks as a fine triangle fan, spheres analytic.
+//! triangles, spheres analytic (disks and cylinders are exact quadrics: see the geometry's
+//! `Quadric`).
 
 use crate::error::InputError;
 use crate::geometry::{ShapeGeometry, Sphere};
 use crate::mesh::TriangleMesh;
 use glam::{DMat4, DVec3, Vec2, Vec3};
 use std::path::Path;
-
-/// Segments of the triangle fan that stands for a disk (area error below 0.04%).
-pub const DISK_SEGMENTS: u32 = 256;
 
 /// The square [-1, 1]² at z = 0, normal +z, with Mitsuba's texture coordinates
 /// ((x + 1) / 2, (y + 1) / 2).
@@ -25,67 +23,6 @@ pub fn rectangle() -> TriangleMesh {
         triangles: vec![[0, 1, 2], [0, 2, 3]],
         attributes: Vec::new(),
     }
-}
-
-/// The unit disk at z = 0, normal +z, as a fan of [`DISK_SEGMENTS`] triangles, with
-/// Mitsuba's texture coordinates (radius, angle / 2π). Each triangle has its own vertices, so
-/// that the angle does not wrap inside a triangle and the centre takes its triangle's angle.
-pub fn disk() -> TriangleMesh {
-    let mut mesh = TriangleMesh::default();
-    let rim = |i: u32| {
-        let phi = std::f32::consts::TAU * i as f32 / DISK_SEGMENTS as f32;
-        Vec3::new(phi.cos(), phi.sin(), 0.0)
-    };
-    let segments = DISK_SEGMENTS as f32;
-    let mut texcoords = Vec::new();
-    for i in 0..DISK_SEGMENTS {
-        let base = mesh.positions.len() as u32;
-        mesh.positions.extend([Vec3::ZERO, rim(i), rim(i + 1)]);
-        texcoords.extend([
-            Vec2::new(0.0, (i as f32 + 0.5) / segments),
-            Vec2::new(1.0, i as f32 / segments),
-            Vec2::new(1.0, (i + 1) as f32 / segments),
-        ]);
-        mesh.triangles.push([base, base + 1, base + 2]);
-    }
-    mesh.texcoords = Some(texcoords);
-    mesh
-}
-
-/// Facets around a cylinder. The flat facets lie within 1.2e-3 radii of the true surface
-/// and their normals within 2.8° of its normals; they keep their own normals (interpolated
-/// vertex normals send rays from near a facet's edge below its plane, into the cylinder).
-/// Finer facets meet at angles so shallow (under about 3°) that a shadow ray leaving near
-/// an edge, offset from the surface as every ray is, can still hit the next facet: at 256
-/// facets that darkened streaks along the cylinder by 30 standard errors against Mitsuba.
-pub const CYLINDER_SEGMENTS: u32 = 64;
-
-/// Mitsuba's cylinder of `radius` from `p0` to `p1` as flat-shaded triangles, open at both
-/// ends, normals outward, with texture coordinates (azimuth / 2π, distance along the axis / length). The
-/// azimuth's origin follows our basis around the axis, which matches Mitsuba's for an axis
-/// along z.
-pub fn cylinder(p0: DVec3, p1: DVec3, radius: f64) -> TriangleMesh {
-    let axis = p1 - p0;
-    let (x, y) = crate::geometry::basis(axis.normalize().as_vec3());
-    let (x, y) = (x.as_dvec3() * radius, y.as_dvec3() * radius);
-    let mut mesh = TriangleMesh::default();
-    let mut texcoords = Vec::new();
-    for i in 0..=CYLINDER_SEGMENTS {
-        let u = i as f64 / CYLINDER_SEGMENTS as f64;
-        let (sin, cos) = (std::f64::consts::TAU * u).sin_cos();
-        let radial = x * cos + y * sin;
-        for (end, v) in [(p0, 0.0), (p1, 1.0)] {
-            mesh.positions.push((end + radial).as_vec3());
-            texcoords.push(Vec2::new(u as f32, v));
-        }
-    }
-    for i in 0..CYLINDER_SEGMENTS {
-        let (a, b) = (2 * i, 2 * i + 2);
-        mesh.triangles.push([a, b, b + 1]);
-        mesh.triangles.push([a, b + 1, a + 1]);
-    }
-    mesh.texcoords = Some(texcoords);
-    mesh
 }
 
 /// The cube [-1, 1]³ with outward faces.
@@ -178,7 +115,6 @@ mod tests {
     fn built_in_shapes_have_the_right_areas() {
         assert!((rectangle().area() - 4.0).abs() < 1e-9);
         assert!((cube().area() - 24.0).abs() < 1e-6);
-        assert!((disk().area() - std::f64::consts::PI).abs() / std::f64::consts::PI < 4e-4);
         // Every face of the cube points outward.
         let c = cube();
         for &[a, b, d] in &c.triangles {

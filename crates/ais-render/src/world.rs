@@ -4,7 +4,8 @@ use crate::bsdf::{read_surface, Material, Surface, TextureScene};
 use crate::camera::Camera;
 use crate::error::InputError;
 use crate::geometry::{
-    Geometry, InstanceInput, SceneShapes, ShapeGeometry, ShapeGroupInput, ShapeInput, Triangle,
+    Geometry, InstanceInput, Quadric, SceneShapes, ShapeGeometry, ShapeGroupInput, ShapeInput,
+    Triangle,
 };
 use crate::lights::reader::{refuse_nested, scene_emitters, spectrum_property};
 use crate::lights::{AreaLight, AreaShape, Emitters, Lights, MeshEmitter, Rectangle};
@@ -96,7 +97,7 @@ fn check_attributes(
     let names = surface.attribute_names();
     let available = match &input.geometry {
         ShapeGeometry::Mesh(mesh) => mesh.attributes.iter().map(|a| a.name.as_str()).collect(),
-        ShapeGeometry::Sphere(_) => Vec::new(),
+        ShapeGeometry::Sphere(_) | ShapeGeometry::Quadric(_) => Vec::new(),
     };
     match names
         .iter()
@@ -203,6 +204,51 @@ fn sphere_shape(
     Ok(BuiltShape { input, light })
 }
 
+/// An exact disk or cylinder under the shape's `to_world`, with its area light.
+fn quadric_shape(
+    file: &std::path::Path,
+    shape: &scene::ShapeDescription,
+    quadric: Option<Quadric>,
+    emission: Option<Emission>,
+    index: u32,
+) -> Result<BuiltShape, InputError> {
+    let quadric = quadric.ok_or_else(|| {
+        InputError::at(
+            file,
+            shape.line,
+            "the shape is degenerate (zero radius, length or scale)",
+        )
+    })?;
+    let bounds = quadric.bounds();
+    let extent = bounds.min.abs().max(bounds.max.abs()).max_element();
+    if !(extent.is_finite() && extent <= crate::mesh::LARGEST_COORDINATE) {
+        return Err(InputError::at(
+            file,
+            shape.line,
+            format!(
+                "the shape reaches {extent:e}, beyond ±{:e}: coordinates this large break the \
+                 BVH's precision; scale the scene down",
+                crate::mesh::LARGEST_COORDINATE
+            ),
+        ));
+    }
+    let light = emission.map(|emission| AreaLight {
+        shape: AreaShape::Quadric {
+            quadric,
+            flipped: shape.flip_normals,
+        },
+        radiance: emission.radiance,
+        texture: emission.texture,
+        shape_index: index,
+    });
+    let input = ShapeInput {
+        geometry: ShapeGeometry::Quadric(quadric),
+        flip_normals: shape.flip_normals,
+        rotation: None,
+    };
+    Ok(BuiltShape { input, light })
+}
+
 /// Loads, transforms and validates shape number `index`, with its area light.
 fn build_shape(
     description: &SceneDescription,
@@ -218,10 +264,16 @@ fn build_shape(
         scene::ShapeGeometry::Sphere { center, radius } => {
             return sphere_shape(file, shape, (*center, *radius), emission, index)
         }
+        scene::ShapeGeometry::Disk => {
+            let disk = Quadric::disk(shape.to_world);
+            return quadric_shape(file, shape, disk, emission, index);
+        }
+        scene::ShapeGeometry::Cylinder { p0, p1, radius } => {
+            let cylinder = Quadric::cylinder(shape.to_world, *p0, *p1, *radius);
+            return quadric_shape(file, shape, cylinder, emission, index);
+        }
         scene::ShapeGeometry::Rectangle => shapes::rectangle(),
-        scene::ShapeGeometry::Disk => shapes::disk(),
         scene::ShapeGeometry::Cube => shapes::cube(),
-        scene::ShapeGeometry::Cylinder { p0, p1, radius } => shapes::cylinder(*p0, *p1, *radius),
         scene::ShapeGeometry::Mesh {
             path,
             format,
@@ -294,7 +346,7 @@ impl World {
         let triangles = (built_sets.iter().flatten())
             .map(|input| match &input.geometry {
                 ShapeGeometry::Mesh(mesh) => mesh.triangles.len(),
-                ShapeGeometry::Sphere(_) => 1,
+                ShapeGeometry::Sphere(_) | ShapeGeometry::Quadric(_) => 1,
             })
             .sum();
         crate::limits::check_geometry_memory(triangles)

@@ -289,6 +289,7 @@ fn placed(shape: &ShapeInput, to_world: glam::Affine3A) -> ShapeInput {
             center: to_world.transform_point3(s.center),
             radius: s.radius * to_world.transform_vector3(Vec3::X).length(),
         }),
+        ShapeGeometry::Quadric(_) => panic!("the test's group holds no quadrics"),
     };
     ShapeInput {
         geometry,
@@ -359,6 +360,58 @@ fn instances_hit_what_copies_of_their_group_hit() {
         assert_eq!(instanced.occluded(&ray), copied.is_some(), "ray {i}");
         let brute = instanced.intersect_brute_force(&ray).map(|h| h.t);
         assert_eq!(brute.is_some(), copied.is_some(), "ray {i}: brute force");
+    }
+    assert!(hits > 300, "the test must exercise hits: {hits}");
+}
+
+#[test]
+fn disks_and_cylinders_in_the_bvh_agree_with_brute_force() {
+    use ais_render::geometry::Quadric;
+    let mut rng = Pcg32::new(53, 5);
+    let mut shapes = Vec::new();
+    for k in 0..60 {
+        let to_world = DMat4::from_translation(
+            DVec3::new(
+                rng.next_f32() as f64,
+                rng.next_f32() as f64,
+                rng.next_f32() as f64,
+            ) * 8.0,
+        ) * DMat4::from_axis_angle(
+            random_unit(&mut rng).as_dvec3(),
+            3.0 * rng.next_f32() as f64,
+        ) * DMat4::from_scale(DVec3::new(0.3 + rng.next_f32() as f64, 0.5, 0.8));
+        let quadric = if k % 2 == 0 {
+            Quadric::disk(to_world)
+        } else {
+            Quadric::cylinder(to_world, DVec3::ZERO, DVec3::new(0.1, 0.2, 1.0), 0.4)
+        };
+        shapes.push(ShapeInput {
+            geometry: ShapeGeometry::Quadric(quadric.unwrap()),
+            flip_normals: false,
+            rotation: None,
+        });
+    }
+    let geometry = Geometry::build(shapes);
+    let mut hits = 0;
+    for i in 0..4000 {
+        let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0 - 1.0;
+        let ray = Ray::new(origin, random_unit(&mut rng));
+        let (fast, slow) = (
+            geometry.intersect(&ray),
+            geometry.intersect_brute_force(&ray),
+        );
+        match (fast, slow) {
+            (Some(a), Some(b)) => {
+                assert!((a.t - b.t).abs() <= 1e-5 * b.t.max(1.0), "ray {i}");
+                assert_eq!(a.shape, b.shape, "ray {i}");
+                let on_surface = (a.point - ray.at(a.t)).length() < 1e-5;
+                assert!(on_surface && a.geometric_normal.is_normalized(), "ray {i}");
+                hits += 1;
+            }
+            (None, None) => {}
+            (a, b) => panic!("ray {i}: BVH {a:?} vs brute force {b:?}"),
+        }
+        assert_eq!(geometry.occluded(&ray), slow.is_some(), "ray {i}");
     }
     assert!(hits > 300, "the test must exercise hits: {hits}");
 }

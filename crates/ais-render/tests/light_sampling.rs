@@ -888,3 +888,60 @@ fn principled_thin_sampling_fits_from_both_sides() {
         .collect();
     assert_sampling_fits(&thin, 100, &both_sides, "principledthin");
 }
+
+/// A disk or cylinder light under `to_world`.
+fn quadric_light(quadric: ais_render::geometry::Quadric) -> AreaLight {
+    AreaLight {
+        shape: AreaShape::Quadric {
+            quadric,
+            flipped: false,
+        },
+        radiance: Vec3::ONE,
+        texture: None,
+        shape_index: 0,
+    }
+}
+
+#[test]
+fn disk_and_cylinder_light_sampling_fits() {
+    use ais_render::geometry::Quadric;
+    use glam::{DMat4, DVec3};
+    // Stretched unevenly and turned, so that the density per area varies (the cylinder's
+    // section is an ellipse) and the transform's normals matter.
+    let to_world = DMat4::from_translation(DVec3::new(0.3, -0.2, 1.5))
+        * DMat4::from_rotation_x(2.2)
+        * DMat4::from_scale(DVec3::new(0.9, 0.5, 1.2));
+    let disk = quadric_light(Quadric::disk(to_world).unwrap());
+    let axis = DVec3::new(0.2, 1.0, 0.3);
+    let cylinder = quadric_light(Quadric::cylinder(to_world, -axis, axis, 0.6).unwrap());
+    // The disk seen from outside; the cylinder from within, near its middle, where every
+    // direction meets it once (seen from outside, its density over directions has an
+    // integrable spike of 1 / cos at the silhouette that binned integrals cannot follow).
+    let outside = Vec3::new(0.1, -0.3, -0.4);
+    let within = to_world
+        .transform_point3(DVec3::new(0.05, 0.1, -0.1))
+        .as_vec3();
+    for (k, (light, point)) in [(disk, outside), (cylinder, within)].iter().enumerate() {
+        let point = *point;
+        // A point drawn behind the light's own near side is another path (its shadow ray is
+        // blocked by the light): the density over directions is that of the first points.
+        let first = |s: &ais_render::lights::AreaSample| {
+            let ray = ais_render::geometry::Ray::new(point, s.direction);
+            light
+                .intersect(&ray)
+                .is_some_and(|hit| (hit.distance - s.distance).abs() < 1e-4 * s.distance)
+        };
+        let p = fit(
+            200_000,
+            60 + k as u64,
+            |u| {
+                light
+                    .sample(point, u)
+                    .filter(first)
+                    .map(|s| (s.direction, s.pdf))
+            },
+            |d| light.pdf(point, d),
+        );
+        assert!(p > SIGNIFICANCE, "light {k}: p = {p}");
+    }
+}

@@ -426,9 +426,11 @@ fn textures_reach_their_parameters_and_warn_where_they_do_not() {
         <bsdf type="roughconductor" id="c">
             <texture type="checkerboard" name="eta"/>
             <texture type="checkerboard" name="alpha"/></bsdf>
+        <bsdf type="roughplastic" id="p"><texture type="checkerboard" name="alpha"/></bsdf>
         <shape type="rectangle"><ref id="d"/></shape>
         <shape type="rectangle"><ref id="c"/></shape>
         <shape type="sphere"><transform name="to_world"><rotate x="1" angle="30"/></transform><ref id="d"/></shape>
+        <shape type="rectangle"><ref id="p"/></shape>
     </scene>"#;
     let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
     let albedo = |shape: usize| match world.surfaces[shape].as_ref() {
@@ -447,10 +449,11 @@ fn textures_reach_their_parameters_and_warn_where_they_do_not() {
         panic!("{:?}", world.surfaces[1]);
     };
     let parameters: Vec<_> = textures.iter().map(|t| t.parameter).collect();
-    assert_eq!(parameters, [ais_render::bsdf::TexturedParameter::Roughness]);
+    use ais_render::bsdf::TexturedParameter::{ConductorEta, Roughness};
+    assert_eq!(parameters, [ConductorEta, Roughness]);
     let warned = |want: &str| world.warnings.iter().any(|w| w.contains(want));
     assert!(
-        warned("textures are not supported: eta"),
+        warned("textures are not supported: alpha \"roughplastic\""),
         "{:?}",
         world.warnings
     );

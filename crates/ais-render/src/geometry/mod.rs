@@ -7,6 +7,7 @@ mod basis;
 mod embree;
 mod instances;
 mod primitive;
+mod quadric;
 mod ray;
 
 pub use basis::basis;
@@ -14,6 +15,7 @@ use instances::{GroupGeometry, Instance};
 pub use instances::{InstanceInput, SceneShapes, ShapeGroupInput};
 use primitive::Packed;
 pub use primitive::{Primitive, Sphere, Triangle};
+pub use quadric::{Quadric, QuadricKind, QuadricSample, QuadricSurface};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
 
 use crate::mesh::{AttributeSite, MeshAttribute, TriangleMesh};
@@ -28,6 +30,8 @@ pub enum ShapeGeometry {
     Mesh(TriangleMesh),
     /// An analytic sphere.
     Sphere(Sphere),
+    /// An exact disk or cylinder.
+    Quadric(Quadric),
 }
 
 /// A shape for [`Geometry::build`].
@@ -101,6 +105,8 @@ pub struct Geometry {
     groups: Vec<GroupGeometry>,
     /// The instances (primitives of this geometry's BVH).
     instances: Vec<Instance>,
+    /// The disks and cylinders (primitives of this geometry's BVH).
+    quadrics: Vec<Quadric>,
     accelerator: Option<Accelerator>,
     triangle_count: usize,
     /// Centre and radius of a sphere around everything.
@@ -220,6 +226,7 @@ impl Geometry {
             sphere_rotations: Vec::new(),
             groups: Vec::new(),
             instances: Vec::new(),
+            quadrics: Vec::new(),
             accelerator: None,
             triangle_count: 0,
             bounds: (Vec3::ZERO, 0.0),
@@ -255,6 +262,16 @@ impl Geometry {
                     index: 0,
                 });
             }
+            ShapeGeometry::Quadric(quadric) => {
+                let index = self.quadrics.len() as u32;
+                self.quadrics.push(quadric);
+                self.primitives.push(Primitive::Quadric { index, quadric });
+                self.sources.push(PrimitiveSource {
+                    shape: slot,
+                    mesh: 0,
+                    index,
+                });
+            }
             ShapeGeometry::Mesh(mesh) => {
                 let mesh_index = self.meshes.len() as u32;
                 for (index, &[a, b, c]) in mesh.triangles.iter().enumerate() {
@@ -288,7 +305,7 @@ impl Geometry {
     /// CWBVH.
     fn build_bvh(&mut self) {
         #[cfg(feature = "embree")]
-        if self.instances.is_empty() && self.build_embree() {
+        if self.instances.is_empty() && self.quadrics.is_empty() && self.build_embree() {
             return;
         }
         self.build_cwbvh();
@@ -385,6 +402,15 @@ impl Geometry {
                     ..hit
                 }))
             }
+            Packed::Quadric(k) => {
+                self.quadrics[k as usize]
+                    .intersect(ray, t_max)
+                    .map(|t| Closest::Primitive {
+                        index,
+                        t,
+                        barycentrics: Vec2::ZERO,
+                    })
+            }
             packed => packed
                 .intersect(ray, t_max)
                 .map(|(t, barycentrics)| Closest::Primitive {
@@ -409,6 +435,9 @@ impl Geometry {
                     f32::INFINITY
                 }
             }
+            Packed::Quadric(k) => self.quadrics[k as usize]
+                .intersect(ray, t_max)
+                .unwrap_or(f32::INFINITY),
             packed => packed
                 .intersect(ray, t_max)
                 .map_or(f32::INFINITY, |(t, _)| t),
@@ -495,6 +524,11 @@ impl Geometry {
             1.0
         };
         let (geometric_normal, shading_normal, uv, [dp_du, dp_dv]) = match &self.packed[index] {
+            Packed::Quadric(k) => {
+                let surface = self.quadrics[*k as usize].surface_at(point);
+                let n = surface.normal * flip;
+                (n, n, surface.uv, [surface.dp_du, surface.dp_dv])
+            }
             // Instances are shaded by their group (see `intersect_primitive`).
             Packed::Instance(_) => (Vec3::Z, Vec3::Z, Vec2::ZERO, [Vec3::X, Vec3::Y]),
             Packed::Sphere(s) => {

@@ -31,6 +31,13 @@ pub enum Primitive {
     Triangle(Triangle),
     /// A sphere.
     Sphere(Sphere),
+    /// A disk or a cylinder: its index among the geometry's quadrics.
+    Quadric {
+        /// Its index.
+        index: u32,
+        /// The surface.
+        quadric: super::quadric::Quadric,
+    },
     /// An instance of a shape group: its index, and its box in world space.
     Instance {
         /// The instance's index.
@@ -49,6 +56,9 @@ pub(crate) enum Packed {
     Triangle([Vec3; 3]),
     /// A sphere.
     Sphere(Sphere),
+    /// A disk or a cylinder, by index (kept in [`super::Geometry`]: it is larger than a
+    /// triangle).
+    Quadric(u32),
     /// An instance of a shape group, by index (its geometry lives in [`super::Geometry`]).
     Instance(u32),
 }
@@ -62,18 +72,19 @@ impl Packed {
                 Packed::Triangle([v0, v1 - v0, v2 - v0])
             }
             Primitive::Sphere(s) => Packed::Sphere(*s),
+            Primitive::Quadric { index, .. } => Packed::Quadric(*index),
             Primitive::Instance { index, .. } => Packed::Instance(*index),
         }
     }
 
     /// The distance and barycentrics (zero for a sphere) of the hit, if within the ray (an
-    /// instance is not tested here: see [`super::Geometry`]).
+    /// instance or a quadric is not tested here: see [`super::Geometry`]).
     #[inline]
     pub(crate) fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, Vec2)> {
         match self {
             Packed::Triangle([v0, e1, e2]) => moller_trumbore(*v0, *e1, *e2, ray, t_max),
             Packed::Sphere(s) => s.intersect(ray, t_max).map(|t| (t, Vec2::ZERO)),
-            Packed::Instance(_) => None,
+            Packed::Quadric(_) | Packed::Instance(_) => None,
         }
     }
 }
@@ -158,6 +169,7 @@ impl obvhs::Boundable for Primitive {
                 let r = glam::Vec3A::splat(s.radius);
                 obvhs::aabb::Aabb::new(c - r, c + r)
             }
+            Primitive::Quadric { quadric, .. } => quadric.bounds(),
             Primitive::Instance { bounds, .. } => *bounds,
         }
     }

@@ -1,5 +1,5 @@
 //! Area lights: spheres (sampled uniformly inside the subtended cone), rectangles (by solid
-//! angle) and triangle meshes ([`MeshEmitter`]: area-weighted triangle choice, uniform points
+//! angle), disks and cylinders (uniformly by area) and triangle meshes ([`MeshEmitter`]: area-weighted triangle choice, uniform points
 //! on the triangle, a BVH for densities and hits). Emission is one-sided, toward the surface normal, as in Mitsuba.
 //! A textured radiance is looked up at the emitting point's texture coordinates (Mitsuba's
 //! layouts on spheres and rectangles, the mesh's own elsewhere); sampling stays by solid
@@ -8,7 +8,7 @@
 use super::mesh_emitter::MeshEmitter;
 use super::spherical_rectangle::Rectangle;
 use super::Receiver;
-use crate::geometry::{sphere_texcoords, Ray, Sphere, Triangle};
+use crate::geometry::{sphere_texcoords, Quadric, Ray, Sphere, Triangle};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
@@ -26,6 +26,14 @@ pub enum AreaShape {
     },
     /// A rectangle, sampled uniformly in the solid angle it subtends.
     Rectangle(Rectangle),
+    /// A disk or a cylinder, sampled uniformly by area, emitting toward its normal (away
+    /// from it when its normals are flipped).
+    Quadric {
+        /// The surface.
+        quadric: Quadric,
+        /// Whether the shape's normals are flipped.
+        flipped: bool,
+    },
     /// Triangles, each emitting toward the side of its (possibly flipped) winding normal.
     Triangles(Box<MeshEmitter>),
 }
@@ -110,6 +118,7 @@ impl AreaLight {
         let area = match &self.shape {
             AreaShape::Sphere { sphere, .. } => 4.0 * PI * (sphere.radius as f64).powi(2),
             AreaShape::Rectangle(rectangle) => rectangle.area(),
+            AreaShape::Quadric { quadric, .. } => quadric.area(),
             AreaShape::Triangles(mesh) => mesh.area(),
         };
         let mean = self
@@ -154,6 +163,7 @@ impl AreaLight {
                 let along = |edge: Vec3| offset.dot(edge) / edge.length_squared();
                 Vec2::new(along(rectangle.edge_x), along(rectangle.edge_y))
             }
+            AreaShape::Quadric { quadric, .. } => quadric.surface_at(point).uv,
             AreaShape::Triangles(mesh) => mesh.texcoords(spot),
         }
     }
@@ -200,6 +210,34 @@ impl AreaLight {
                     spot: LightSpot::default(),
                 })
             }
+            AreaShape::Quadric { quadric, flipped } => {
+                let drawn = quadric.sample(u);
+                let offset = drawn.point - point;
+                let distance = offset.length();
+                let direction = offset / distance;
+                let normal = if *flipped {
+                    -drawn.normal
+                } else {
+                    drawn.normal
+                };
+                let mut sample = AreaSample {
+                    direction,
+                    pdf: 0.0,
+                    distance,
+                    normal,
+                    spot: LightSpot::default(),
+                };
+                // Where the direction first meets the light is the point drawn, take it as
+                // the ray finds it, as the density of a direction is found (at a grazing
+                // silhouette the two differ in f32).
+                let first = self.intersect(&Ray::new(point, direction));
+                if let Some(hit) = first.filter(|h| (h.distance - distance).abs() < 1e-4 * distance)
+                {
+                    (sample.distance, sample.normal) = (hit.distance, hit.normal);
+                }
+                sample.pdf = self.density_at(receiver, direction, sample.distance, sample.normal);
+                (sample.pdf.is_finite() && sample.pdf > 0.0).then_some(sample)
+            }
             AreaShape::Triangles(mesh) => mesh.sample(point, u),
         }
     }
@@ -220,6 +258,11 @@ impl AreaLight {
                 .map_or(0.0, |(_, cos_max)| 1.0 / (2.0 * PI * (1.0 - cos_max))),
             AreaShape::Rectangle(rectangle) => {
                 1.0 / Rectangle::view_solid_angle(receiver.rectangle_view(rectangle))
+            }
+            AreaShape::Quadric { quadric, .. } => {
+                let point = receiver.point + direction * distance;
+                let cos = normal.dot(direction).abs() as f64;
+                quadric.area_density(point) * (distance as f64).powi(2) / cos
             }
             AreaShape::Triangles(mesh) => mesh.density_at(direction, distance, normal),
         }
@@ -255,6 +298,12 @@ impl AreaLight {
                     0.0
                 }
             }
+            AreaShape::Quadric { .. } => {
+                let Some(hit) = self.intersect(&Ray::new(point, direction)) else {
+                    return 0.0;
+                };
+                self.density_at(receiver, direction, hit.distance, hit.normal)
+            }
             AreaShape::Triangles(mesh) => mesh.pdf(point, direction),
         }
     }
@@ -268,6 +317,11 @@ impl AreaLight {
                 (t, if *flipped { -n } else { n })
             }
             AreaShape::Rectangle(rectangle) => (rectangle.intersect(ray)?, rectangle.normal),
+            AreaShape::Quadric { quadric, flipped } => {
+                let t = quadric.intersect(ray, ray.t_max)?;
+                let n = quadric.surface_at(ray.at(t)).normal;
+                (t, if *flipped { -n } else { n })
+            }
             AreaShape::Triangles(mesh) => return mesh.intersect(ray),
         };
         Some(AreaHit {
