@@ -401,12 +401,16 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
     // The field learned in each render's first passes rolls the later ones' candidates,
     // guides their environment draws, or both, through a window: every pixel agrees with
     // AIS off. The interior's sky is an environment map; the overcast room's a constant.
+    // Among several lights, it guides the choice of a light.
     let cases = [
         ("interior.xml", Strategy::Mis, MapUse::Roulette),
         ("interior.xml", Strategy::Mis, MapUse::Proposal),
         ("interior.xml", Strategy::Light, MapUse::Proposal),
         ("interior.xml", Strategy::Mis, MapUse::Both),
         ("overcast_room.xml", Strategy::Mis, MapUse::Both),
+        // Four sphere lights among pillars: cells choose among the lights by what they see.
+        ("sphere_lights.xml", Strategy::Mis, MapUse::Proposal),
+        ("sphere_lights.xml", Strategy::Light, MapUse::Both),
     ];
     for (scene, strategy, map_use) in cases {
         let world = small_shipped_scene(scene);

@@ -370,6 +370,30 @@ fn light_selection_mixture_fits() {
     assert!(p > SIGNIFICANCE, "p = {p}");
 }
 
+#[test]
+fn a_learned_choice_among_the_lights_fits() {
+    // A field cell's choice among the lights (rectangle, sphere, environment) replaces the
+    // choice by power, in the draws and in the density alike.
+    let lights = mixed_lights();
+    let choice = ais::sampling::AliasTable::new(&[0.7, 0.05, 0.25]);
+    let mut receiver = Receiver::new(Vec3::ZERO);
+    receiver.light_choice = Some(&choice);
+    let p = fit(
+        200_000,
+        16,
+        |u| {
+            let direction = lights.sample_toward(&receiver, u)?.direction;
+            let pdf = lights.pdf_over_directions(&receiver, direction);
+            (pdf > 0.0).then_some((direction, pdf))
+        },
+        |d| lights.pdf_over_directions(&receiver, d),
+    );
+    assert!(p > SIGNIFICANCE, "p = {p}");
+    assert_eq!(lights.source_count(), 3);
+    let power = lights.power_choice();
+    assert!((power.iter().sum::<f64>() - 1.0).abs() < 1e-5, "{power:?}");
+}
+
 /// A tilted surface seen obliquely, where the proposal tests gather.
 fn surface_point() -> SurfacePoint<'static> {
     let normal = Vec3::new(0.2, 0.1, 1.0).normalize();

@@ -62,7 +62,7 @@ impl SampleIntegrator for Oracle {
     type Learned = ();
     type Tile = OracleTile;
 
-    fn new_learning(&self) {}
+    fn new_learning(&self, _world: &World) {}
 
     fn begin_tile(&self, _: &World, _: &Tile, _: &(), _: &mut RayCounts) -> OracleTile {
         OracleTile::default()

@@ -166,8 +166,8 @@ impl SampleIntegrator for TimedGather {
         Integrator::Gather(self.0).passes(world, spp)
     }
 
-    fn new_learning(&self) -> GatherLearning {
-        GatherLearning::new(&self.0)
+    fn new_learning(&self, world: &World) -> GatherLearning {
+        GatherLearning::new(world, &self.0)
     }
 
     fn begin_tile(

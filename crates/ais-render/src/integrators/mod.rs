@@ -73,10 +73,10 @@ impl SampleIntegrator for Integrator {
         }
     }
 
-    fn new_learning(&self) -> GatherLearning {
+    fn new_learning(&self, world: &World) -> GatherLearning {
         match self {
-            Integrator::Gather(settings) => GatherLearning::new(settings),
-            _ => GatherLearning::new(&GatherSettings::default()),
+            Integrator::Gather(settings) => GatherLearning::new(world, settings),
+            _ => GatherLearning::new(world, &GatherSettings::default()),
         }
     }
 

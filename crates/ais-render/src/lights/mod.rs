@@ -102,10 +102,50 @@ impl Lights {
         self.choice.is_none()
     }
 
-    /// Probability of choosing light `index` (area lights first, then the environment).
-    fn choice_probability(&self, index: usize) -> f64 {
+    /// How many lights light sampling chooses among (area, delta, the environment): the
+    /// sources of [`Lights::source_of`].
+    pub fn source_count(&self) -> usize {
+        self.environment_index() + usize::from(self.environment.is_some())
+    }
+
+    /// The probabilities of choosing each light by its power (indexed as
+    /// [`Lights::source_of`]).
+    pub fn power_choice(&self) -> Vec<f64> {
+        (0..self.source_count())
+            .map(|index| self.power_probability(index))
+            .collect()
+    }
+
+    /// The light that `toward` (resolved) meets first, indexed as light sampling chooses
+    /// them: area lights, delta lights, the environment (`None`: nothing emits along it, or
+    /// it was not resolved).
+    pub fn source_of(&self, toward: &Toward) -> Option<usize> {
+        match toward.source {
+            Source::Area(point) => Some(point.light),
+            Source::Delta(delta, _) => Some(self.area.len() + delta),
+            Source::Environment => Some(self.environment_index()),
+            Source::Dark | Source::Unknown => None,
+        }
+    }
+
+    /// The choice of a light for `receiver`: its own (a field cell's), else by power.
+    #[inline]
+    fn choice_for<'r>(&'r self, receiver: &Receiver<'r>) -> Option<&'r AliasTable> {
+        receiver.light_choice.or(self.choice.as_ref())
+    }
+
+    /// Probability of choosing light `index` by its power.
+    fn power_probability(&self, index: usize) -> f64 {
         self.choice
             .as_ref()
+            .map_or(0.0, |c| c.probability(index) as f64)
+    }
+
+    /// Probability of choosing light `index` (area lights first, then delta lights, then
+    /// the environment) for `receiver`.
+    #[inline]
+    fn choice_probability(&self, receiver: &Receiver, index: usize) -> f64 {
+        self.choice_for(receiver)
             .map_or(0.0, |c| c.probability(index) as f64)
     }
 
@@ -121,16 +161,17 @@ impl Lights {
     /// when it has one.
     #[inline]
     pub fn sample_toward(&self, receiver: &Receiver, u: [f32; 2]) -> Option<Toward> {
-        let choice = self.choice.as_ref()?;
+        let choice = self.choice_for(receiver)?;
         let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
             let light = &self.area[index];
             let sample = light.sample_for(receiver, [u0, u[1]])?;
             let target = receiver.point + sample.direction * sample.distance;
             let point = AreaPoint {
+                light: index,
                 target,
                 radiance: light.emitted(sample.normal, sample.direction, target, sample.spot),
-                density: self.choice_probability(index) * sample.pdf,
+                density: choice.probability(index) as f64 * sample.pdf,
             };
             return Some(Toward::area(sample.direction, point));
         }
@@ -165,7 +206,7 @@ impl Lights {
     pub fn pdf_over_directions(&self, receiver: &Receiver, direction: Vec3) -> f64 {
         let mut pdf = 0.0;
         for (index, light) in self.area.iter().enumerate() {
-            let p = self.choice_probability(index);
+            let p = self.choice_probability(receiver, index);
             if p > 0.0 {
                 pdf += p * light.pdf_for(receiver, direction);
             }
@@ -184,7 +225,7 @@ impl Lights {
     pub fn pdf_toward(&self, receiver: &Receiver, toward: &mut Toward) -> f64 {
         self.resolve(receiver, toward);
         match toward.source {
-            Source::Delta(delta, _) => self.choice_probability(self.area.len() + delta),
+            Source::Delta(delta, _) => self.choice_probability(receiver, self.area.len() + delta),
             Source::Area(point) => point.density,
             Source::Environment => self.environment_density(receiver, toward),
             Source::Dark | Source::Unknown => 0.0,
@@ -200,7 +241,7 @@ impl Lights {
             Some(guide) => guide.pdf(environment, toward),
             None => environment.pdf_toward(toward),
         };
-        self.choice_probability(self.environment_index()) * density
+        self.choice_probability(receiver, self.environment_index()) * density
     }
 
     /// What `toward` brings to `receiver` if nothing that does not emit is in the way, and
@@ -282,9 +323,10 @@ impl Lights {
                     light.density_at(receiver, toward.direction, hit.distance, hit.normal);
                 let target = receiver.point + toward.direction * hit.distance;
                 Source::Area(AreaPoint {
+                    light: index,
                     target,
                     radiance: light.emitted(hit.normal, toward.direction, target, hit.spot),
-                    density: self.choice_probability(index) * density,
+                    density: self.choice_probability(receiver, index) * density,
                 })
             }
             None if self.environment.is_some() => Source::Environment,

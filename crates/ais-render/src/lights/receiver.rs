@@ -7,6 +7,7 @@
 
 use super::spherical_rectangle::{Rectangle, View};
 use super::EnvironmentGuide;
+use ais::sampling::AliasTable;
 use glam::Vec3;
 use std::cell::Cell;
 
@@ -23,6 +24,9 @@ pub struct Receiver<'a> {
     /// Light sampling draws the environment from its product with this guide (guided
     /// gathers), or from the environment alone (`None`).
     pub environment_guide: Option<&'a EnvironmentGuide>,
+    /// Light sampling chooses among the lights by this table (a field cell's learned
+    /// choice), or by their power (`None`).
+    pub light_choice: Option<&'a AliasTable>,
     views: [ViewSlot; VIEW_SLOTS],
 }
 
@@ -32,6 +36,7 @@ impl<'a> Receiver<'a> {
         Receiver {
             point,
             environment_guide: None,
+            light_choice: None,
             views: Default::default(),
         }
     }

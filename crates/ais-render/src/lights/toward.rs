@@ -30,6 +30,8 @@ pub(super) enum Source {
 /// The point of an area light that a candidate direction meets.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct AreaPoint {
+    /// The light (its index among the scene's area lights).
+    pub light: usize,
     /// Where it is (world space).
     pub target: Vec3,
     /// Radiance it sends toward the receiver (zero from its back side).

@@ -83,8 +83,8 @@ pub trait SampleIntegrator: Sync {
         vec![spp]
     }
 
-    /// What it knows before the first pass.
-    fn new_learning(&self) -> Self::Learned;
+    /// What it knows of `world` before the first pass.
+    fn new_learning(&self, world: &World) -> Self::Learned;
 
     /// The state for `tile`, reading what was learned before this pass; work done here (a
     /// learning pass, say) counts its rays in `counts`.

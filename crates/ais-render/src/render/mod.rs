@@ -133,7 +133,7 @@ pub fn render<I: SampleIntegrator>(
     integrator: &I,
     settings: &RenderSettings,
 ) -> RenderOutput<<I::Tile as TileState>::Stats> {
-    let mut learned = integrator.new_learning();
+    let mut learned = integrator.new_learning(world);
     render_passes(world, integrator, settings, &mut learned, false)
 }
 

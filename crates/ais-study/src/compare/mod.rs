@@ -295,7 +295,7 @@ fn progressive(
         curve: Vec::new(),
         ais_memory_per_thread: 0,
     };
-    let mut learned = GatherLearning::new(&configuration.settings);
+    let mut learned = GatherLearning::new(world, &configuration.settings);
     loop {
         let pass_seed = mix64(seed ^ mix64(run.spp as u64 + 1));
         let output = configuration.render_pass(world, pass_spp, pass_seed, &mut learned);

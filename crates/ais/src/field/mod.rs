@@ -16,6 +16,10 @@
 //! wherever it is), and by the dominant axis of the normal. Each cell holds an equal-area
 //! octahedral map of `side × side` texels ([`octahedral`]). A lookup is one hash probe per
 //! gather and one texel index per candidate: O(1) whatever the scene.
+//!
+//! A cell may also count rays by *source*: whatever the host says a ray aimed at (one of
+//! its emitters, say), so that it can learn which sources a cell sees
+//! ([`VisibilityField::with_sources`], [`FieldCell::source_visibility`]).
 
 pub mod octahedral;
 
@@ -134,11 +138,14 @@ pub struct CellIndex(u32);
 #[derive(Clone, Debug)]
 pub struct VisibilityField {
     side: u32,
+    /// Sources counted per cell, after its texels.
+    sources: u32,
     /// Pseudo-observations added to every cell (of a free ray) and texel (at its cell's
     /// visibility).
     prior: f32,
     /// Cell → index of its first texel in `counts`.
     cells: KeyMap<u32>,
+    /// Per cell, its texels' counts, then its sources'.
     counts: Vec<TexelCounts>,
     /// Per cell, the sum of its texels' counts.
     totals: Vec<TexelCounts>,
@@ -164,6 +171,7 @@ impl VisibilityField {
     pub fn new(side: u32) -> Self {
         VisibilityField {
             side: side.clamp(1, 64),
+            sources: 0,
             prior: PRIOR_FREE,
             cells: KeyMap::default(),
             counts: Vec::new(),
@@ -187,9 +195,28 @@ impl VisibilityField {
         }
     }
 
+    /// This field with `sources` counts per cell, besides its texels, of the rays the host
+    /// says aimed at each source (at most [`MOST_SOURCES`]).
+    pub fn with_sources(self, sources: u32) -> Self {
+        VisibilityField {
+            sources: sources.min(MOST_SOURCES),
+            ..self
+        }
+    }
+
     /// Texels per side of a cell's map.
     pub fn side(&self) -> u32 {
         self.side
+    }
+
+    /// Sources counted per cell.
+    pub fn sources(&self) -> u32 {
+        self.sources
+    }
+
+    /// Counts held per cell: its texels, then its sources.
+    fn stride(&self) -> usize {
+        (self.side * self.side + self.sources) as usize
     }
 
     /// Number of cells learned.
@@ -214,10 +241,10 @@ impl VisibilityField {
         if self.planned == Some(cost_ratio) {
             return;
         }
-        let texels = (self.side * self.side) as usize;
+        let (texels, stride) = ((self.side * self.side) as usize, self.stride());
         self.expected_rejection = (0..self.totals.len())
             .map(|cell| {
-                let counts = &self.counts[cell * texels..(cell + 1) * texels];
+                let counts = &self.counts[cell * stride..cell * stride + texels];
                 expected_rejection(counts, self.totals[cell], self.prior, cost_ratio)
             })
             .collect();
@@ -237,8 +264,7 @@ impl VisibilityField {
             all += rays;
             if total.traced >= LEAST_EVIDENCE {
                 known += rays;
-                let cell =
-                    self.cell_at(CellIndex((index * (self.side * self.side) as usize) as u32));
+                let cell = self.cell_at(CellIndex((index * self.stride()) as u32));
                 if cell.worth_rolling(cost_ratio) {
                     rolling += rays;
                 }
@@ -265,10 +291,11 @@ impl VisibilityField {
     /// merge).
     #[inline]
     pub fn cell_at(&self, CellIndex(first): CellIndex) -> FieldCell<'_> {
-        let texels = (self.side * self.side) as usize;
-        let index = first as usize / texels;
+        let (texels, first) = ((self.side * self.side) as usize, first as usize);
+        let index = first / self.stride();
         FieldCell {
-            counts: &self.counts[first as usize..first as usize + texels],
+            counts: &self.counts[first..first + texels],
+            sources: &self.counts[first + texels..first + self.stride()],
             total: self.totals[index],
             darkest: self.darkest[index],
             planned: self
@@ -279,13 +306,15 @@ impl VisibilityField {
         }
     }
 
-    /// Adds what a tile observed (observations made with another `side` are refused).
+    /// Adds what a tile observed (observations made with another `side` or number of
+    /// sources are refused).
     pub fn merge(&mut self, observations: &FieldObservations) {
         assert_eq!(
-            observations.side, self.side,
+            (observations.side, observations.sources),
+            (self.side, self.sources),
             "observations of another map size"
         );
-        let texels = (self.side * self.side) as usize;
+        let (texels, stride) = ((self.side * self.side) as usize, self.stride());
         if !observations.cells.is_empty() {
             self.planned = None;
         }
@@ -293,14 +322,16 @@ impl VisibilityField {
             let next = self.counts.len() as u32;
             let first = *self.cells.entry(*key).or_insert_with(|| next) as usize;
             if first == next as usize {
-                self.counts.resize(first + texels, TexelCounts::default());
+                self.counts.resize(first + stride, TexelCounts::default());
                 self.totals.push(TexelCounts::default());
                 self.darkest.push(1.0);
             }
-            let index = first / texels;
-            for (texel, &count) in seen.iter().enumerate() {
-                self.counts[first + texel].add(count);
-                self.totals[index].add(count);
+            let index = first / stride;
+            for (slot, &count) in seen.iter().enumerate() {
+                self.counts[first + slot].add(count);
+                if slot < texels {
+                    self.totals[index].add(count);
+                }
             }
             let cell = visibility(self.totals[index], self.prior);
             self.darkest[index] = self.counts[first..first + texels]
@@ -310,6 +341,9 @@ impl VisibilityField {
         }
     }
 }
+
+/// The most sources a field counts per cell.
+pub const MOST_SOURCES: u32 = 64;
 
 /// Pseudo-observations added to every cell (of a free ray) and to every texel (at its
 /// cell's visibility): a texel seen a few times stays like its cell, and only its own
@@ -402,6 +436,8 @@ pub fn acceptance(texel: f32, cell: f32, cost_ratio: f32) -> f32 {
 #[derive(Clone, Copy, Debug)]
 pub struct FieldCell<'a> {
     counts: &'a [TexelCounts],
+    /// The counts of the rays aimed at each source.
+    sources: &'a [TexelCounts],
     total: TexelCounts,
     /// The lowest visibility of its texels.
     darkest: f32,
@@ -428,6 +464,19 @@ impl FieldCell<'_> {
     pub fn texel_visibility_at(&self, index: usize) -> Option<f32> {
         let counts = *self.counts.get(index)?;
         (counts.traced > 0).then(|| texel_visibility(counts, self.visibility(), self.prior))
+    }
+
+    /// The visibility of the rays aimed at `source`, with the field's prior (centred on the
+    /// cell's visibility, as a texel's), or `None` where the field does not count it or no
+    /// such ray was recorded.
+    pub fn source_visibility(&self, source: usize) -> Option<f32> {
+        let counts = *self.sources.get(source)?;
+        (counts.traced > 0).then(|| texel_visibility(counts, self.visibility(), self.prior))
+    }
+
+    /// The counts of the rays aimed at `source` (zero where the field does not count it).
+    pub fn source_counts(&self, source: usize) -> TexelCounts {
+        self.sources.get(source).copied().unwrap_or_default()
     }
 
     /// The lowest visibility of the cell's texels.
@@ -480,6 +529,7 @@ impl FieldCell<'_> {
 #[derive(Clone, Debug)]
 pub struct FieldObservations {
     side: u32,
+    sources: u32,
     cells: KeyMap<Box<[TexelCounts]>>,
 }
 
@@ -488,7 +538,17 @@ impl FieldObservations {
     pub fn new(side: u32) -> Self {
         FieldObservations {
             side: side.clamp(1, 64),
+            sources: 0,
             cells: KeyMap::default(),
+        }
+    }
+
+    /// These observations with `sources` counts per cell (as
+    /// [`VisibilityField::with_sources`]).
+    pub fn with_sources(self, sources: u32) -> Self {
+        FieldObservations {
+            sources: sources.min(MOST_SOURCES),
+            ..self
         }
     }
 
@@ -500,11 +560,11 @@ impl FieldObservations {
 
     /// The counts of cell `key`, to record a gather's rays with one hash probe.
     pub fn cell_mut(&mut self, key: CellKey) -> CellRecorder<'_> {
-        let texels = (self.side * self.side) as usize;
+        let slots = (self.side * self.side + self.sources) as usize;
         let counts = self
             .cells
             .entry(key)
-            .or_insert_with(|| vec![TexelCounts::default(); texels].into_boxed_slice());
+            .or_insert_with(|| vec![TexelCounts::default(); slots].into_boxed_slice());
         CellRecorder {
             counts,
             side: self.side,
@@ -523,10 +583,10 @@ impl FieldObservations {
 
     /// Bytes held.
     pub fn memory_bytes(&self) -> usize {
-        let texels = (self.side * self.side) as usize;
+        let slots = (self.side * self.side + self.sources) as usize;
         std::mem::size_of::<Self>()
             + self.cells.capacity() * std::mem::size_of::<(CellKey, Box<[TexelCounts]>)>()
-            + self.cells.len() * texels * std::mem::size_of::<TexelCounts>()
+            + self.cells.len() * slots * std::mem::size_of::<TexelCounts>()
     }
 }
 
@@ -540,10 +600,28 @@ impl CellRecorder<'_> {
     /// Records one traced ray toward `direction`: free or blocked.
     #[inline]
     pub fn record(&mut self, direction: [f32; 3], free: bool) {
-        let texel = &mut self.counts[octahedral::texel_of(direction, self.side)];
-        texel.traced = texel.traced.saturating_add(1);
-        texel.free = texel.free.saturating_add(u32::from(free));
+        count(
+            &mut self.counts[octahedral::texel_of(direction, self.side)],
+            free,
+        );
     }
+
+    /// Records that a traced ray aimed at `source` was free or blocked (a source the
+    /// observations do not count is ignored).
+    #[inline]
+    pub fn record_source(&mut self, source: usize, free: bool) {
+        let texels = (self.side * self.side) as usize;
+        if let Some(counts) = self.counts[texels..].get_mut(source) {
+            count(counts, free);
+        }
+    }
+}
+
+/// One more traced ray in `counts`, free or not.
+#[inline]
+fn count(counts: &mut TexelCounts, free: bool) {
+    counts.traced = counts.traced.saturating_add(1);
+    counts.free = counts.free.saturating_add(u32::from(free));
 }
 
 #[cfg(test)]
@@ -767,5 +845,52 @@ mod tests {
         assert_ne!(b, c);
         let far = CellKey::new([f32::INFINITY, f32::NAN, 1e30], [0.0, 0.0, 1.0], -3);
         assert_eq!(far.coordinates, [0, 0, i32::MAX]);
+    }
+
+    #[test]
+    fn sources_are_counted_apart_from_the_texels() {
+        let mut field = VisibilityField::new(4).with_sources(3);
+        let key = CellKey::new([1.0, 2.0, 3.0], [0.0, 0.0, 1.0], 0);
+        let other = CellKey::new([9.0, 2.0, 3.0], [0.0, 0.0, 1.0], 0);
+        let mut observations = FieldObservations::new(4).with_sources(3);
+        let mut cell = observations.cell_mut(key);
+        for k in 0..40 {
+            cell.record([0.0, 0.0, 1.0], k % 4 == 0);
+            cell.record_source(k % 2, k % 4 == 0);
+        }
+        cell.record_source(7, true);
+        observations.record(other, [1.0, 0.0, 0.0], true);
+        field.merge(&observations);
+        let cell = field.cell(&key).unwrap();
+        assert_eq!(
+            cell.total(),
+            TexelCounts {
+                free: 10,
+                traced: 40
+            }
+        );
+        assert_eq!(
+            cell.source_counts(0),
+            TexelCounts {
+                free: 10,
+                traced: 20
+            }
+        );
+        assert_eq!(
+            cell.source_counts(1),
+            TexelCounts {
+                free: 0,
+                traced: 20
+            }
+        );
+        assert_eq!(cell.source_visibility(2), None, "no ray aimed at it");
+        assert_eq!(cell.source_visibility(7), None, "not counted");
+        let (seen, blocked) = (
+            cell.source_visibility(0).unwrap(),
+            cell.source_visibility(1).unwrap(),
+        );
+        assert!(seen > 0.4 && blocked < 0.05, "{seen} {blocked}");
+        assert_eq!(field.cell(&other).unwrap().total().traced, 1);
+        assert_eq!(field.cell(&other).unwrap().source_counts(0).traced, 0);
     }
 }

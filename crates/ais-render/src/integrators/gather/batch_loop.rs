@@ -114,6 +114,9 @@ pub fn run_batch<P: BatchProbe>(
             };
             if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), traced.free) {
                 recorder.record(direction.into(), free);
+                if let Some(source) = traced.source {
+                    recorder.record_source(source, free);
+                }
             }
             batch.record(traced.value.to_array(), traced.rating);
             if let (Some(clock), Some(started)) = (run.clock, started) {
@@ -202,6 +205,8 @@ struct Traced {
     /// Whether its ray toward light was free (None: no such ray was traced, or it brought
     /// nothing).
     free: Option<bool>,
+    /// The light it aimed at, indexed as light sampling chooses them (None: none).
+    source: Option<usize>,
 }
 
 /// Traces an accepted candidate whose value alone is wanted (with whether its ray was
@@ -210,12 +215,15 @@ struct Traced {
 /// as nothing reads it (the batch has no map to learn).
 fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> Traced {
     let at = run.at;
+    let shadow_ray = free_radiance(run.world, at, &mut toward, counts);
+    let source = run.world.lights.source_of(&toward);
     let nothing = |free| Traced {
         value: Vec3::ZERO,
         rating: 0.0,
         free,
+        source,
     };
-    let radiance = match free_radiance(run.world, at, &mut toward, counts) {
+    let radiance = match shadow_ray {
         ShadowRay::Unneeded => return nothing(None),
         ShadowRay::Blocked => return nothing(Some(false)),
         ShadowRay::Free(radiance) => radiance,
@@ -229,6 +237,7 @@ fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> T
         value: at.scattering(&toward) * radiance / pdf as f32,
         rating: 0.0,
         free: Some(true),
+        source,
     }
 }
 
@@ -253,6 +262,7 @@ fn trace(
             value: Vec3::ZERO,
             rating: rating(0.0, 0.0),
             free: None,
+            source: None,
         };
     }
     let actual = leaving.trace(run.world, counts);
@@ -262,5 +272,6 @@ fn trace(
         rating,
         // A ray was traced toward light only if it could bring some.
         free: (leaving.unoccluded != Vec3::ZERO).then_some(rating > 0.0),
+        source: run.world.lights.source_of(&toward),
     }
 }

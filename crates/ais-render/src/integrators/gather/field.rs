@@ -55,13 +55,23 @@ pub fn field_rolls(settings: &GatherSettings) -> bool {
     settings.map_use.rolls() && settings.rays >= LEAST_ROLLING_RAYS
 }
 
+/// The lights whose rays the field counts per cell, to choose among them by what a cell
+/// sees: all of light sampling's choices where there are two or more, else none.
+pub fn counted_sources(world: &World) -> usize {
+    match world.lights.source_count() {
+        count if count >= 2 => count,
+        _ => 0,
+    }
+}
+
 /// Whether the field can change anything in `world` with these settings (`map = field`):
-/// its roulette runs ([`field_rolls`]), or it can guide light sampling toward an
-/// environment. Elsewhere (area lights only, and fewer than [`LEAST_ROLLING_RAYS`]
-/// candidates) the gather renders as AIS off: one pass, nothing recorded or timed.
+/// its roulette runs ([`field_rolls`]), or it can guide light sampling (toward an
+/// environment, or among two or more lights). Elsewhere (one area light, and fewer than
+/// [`LEAST_ROLLING_RAYS`] candidates) the gather renders as AIS off: one pass, nothing
+/// recorded or timed.
 pub fn field_has_use(world: &World, settings: &GatherSettings) -> bool {
     let guides = settings.map_use.guides()
-        && world.lights.environment.is_some()
+        && (world.lights.environment.is_some() || counted_sources(world) > 0)
         && matches!(settings.strategy, Strategy::Light | Strategy::Mis);
     settings.map == MapSource::Field && (field_rolls(settings) || guides)
 }
@@ -150,9 +160,12 @@ pub struct GatherLearning {
 }
 
 impl GatherLearning {
-    /// An empty field for these settings (`field_res`, `field_prior`).
-    pub fn new(settings: &GatherSettings) -> Self {
-        let field = VisibilityField::new(settings.field_res).with_prior(settings.field_prior);
+    /// An empty field for these settings (`field_res`, `field_prior`), counting the rays
+    /// aimed at each of `world`'s lights where light sampling may choose among them.
+    pub fn new(world: &World, settings: &GatherSettings) -> Self {
+        let field = VisibilityField::new(settings.field_res)
+            .with_prior(settings.field_prior)
+            .with_sources(counted_sources(world) as u32);
         GatherLearning {
             field: Arc::new(field),
             cost: CostSample::default(),
@@ -317,8 +330,10 @@ pub(super) fn field_gather<P: BatchProbe>(
         .filter(|cell| rolls && cell.worth_rolling(cost_ratio));
     let mut at: GatherPoint<'_> = site.at;
     if let (Some(guides), Some((index, cell))) = (field_guides.as_mut(), known) {
-        at.receiver.environment_guide = guides.guide(index, &cell);
-        *field_guided += u64::from(at.receiver.environment_guide.is_some());
+        let guide = guides.guide(index, &cell);
+        at.receiver.environment_guide = guide.environment.as_ref();
+        at.receiver.light_choice = guide.lights.as_ref();
+        *field_guided += u64::from(guide.environment.is_some() || guide.lights.is_some());
     }
     field_gathers[usize::from(rolling.is_none())] += 1;
     *gathers += 1;

@@ -1,6 +1,12 @@
 //! Light sampling guided by the visibility field (`map = field` with `map_use = proposal`
 //! or `both`).
 //!
+//! Where a scene has two or more lights, a cell also chooses among them by what it saw:
+//! each light's probability of being chosen is a defensive mixture of its share of the
+//! power (as unguided light sampling chooses) and that share weighed by the visibility of
+//! the rays the cell aimed at it. A light hidden from the cell is chosen less, one in view
+//! more; the choice's probabilities are exact, so nothing is biased.
+//!
 //! In a cell whose texels the field knows, the environment is drawn from a defensive
 //! mixture of its own distribution and its exact product with the cell's texel
 //! visibilities ([`EnvironmentGuide`] on the field's octahedral texels): the sky that the
@@ -15,6 +21,7 @@
 
 use crate::lights::{Environment, EnvironmentGuide, EnvironmentPartition, GuideLayout};
 use crate::world::World;
+use ais::sampling::AliasTable;
 use ais::field::{CellIndex, FieldCell, LEAST_EVIDENCE, LOWEST_ACCEPTANCE};
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -40,14 +47,26 @@ pub const FIELD_GUIDE_FRACTION: f32 = 0.75;
 /// it guided about as many cells and lost 10% of the gain in the sunlit room.)
 pub const GUIDE_CONTRAST: f32 = 0.5;
 
-/// A tile's environment guides, one per cell of the field it met (none where the cell is
-/// not worth guiding).
+/// What guides light sampling in one cell of the field.
+#[derive(Default)]
+pub struct CellGuide {
+    /// The environment drawn through its product with the cell's texels (`None`: not
+    /// worth it here).
+    pub environment: Option<EnvironmentGuide>,
+    /// The choice among the lights by what the cell sees of them (`None`: by power).
+    pub lights: Option<AliasTable>,
+}
+
+/// A tile's guides, one per cell of the field it met.
 pub struct FieldGuides {
     /// The environment's cells grouped by the field's texels (`None`: the scene has no
     /// environment, or light sampling is not in the proposal).
     partition: Option<Arc<EnvironmentPartition>>,
-    by_cell: HashMap<CellIndex, Option<EnvironmentGuide>>,
-    /// The product's share β of the mixture.
+    /// Light sampling's probabilities of choosing each light by power (empty: the field
+    /// does not choose among the lights).
+    power_choice: Vec<f64>,
+    by_cell: HashMap<CellIndex, CellGuide>,
+    /// The guided share β of each mixture.
     fraction: f64,
 }
 
@@ -65,32 +84,74 @@ impl FieldGuides {
             }
             _ => None,
         };
+        let counted = super::field::counted_sources(world) > 0 && samples_lights;
         FieldGuides {
             partition,
+            power_choice: if counted {
+                world.lights.power_choice()
+            } else {
+                Vec::new()
+            },
             by_cell: HashMap::new(),
             fraction: fraction as f64,
         }
     }
 
-    /// The guide of the cell at `index`, built on first use (`None`: unguided there).
-    pub fn guide(&mut self, index: CellIndex, cell: &FieldCell) -> Option<&EnvironmentGuide> {
-        let partition = self.partition.as_ref()?;
-        let fraction = self.fraction;
-        self.by_cell
-            .entry(index)
-            .or_insert_with(|| build(partition, cell, fraction))
-            .as_ref()
+    /// The guide of the cell at `index`, built on first use.
+    pub fn guide(&mut self, index: CellIndex, cell: &FieldCell) -> &CellGuide {
+        let (partition, power, fraction) = (&self.partition, &self.power_choice, self.fraction);
+        self.by_cell.entry(index).or_insert_with(|| CellGuide {
+            environment: partition
+                .as_ref()
+                .and_then(|partition| build(partition, cell, fraction)),
+            lights: light_choice(power, cell, fraction),
+        })
     }
 
     /// Bytes held by the guides (the shared partition is counted by the environment).
     pub fn memory_bytes(&self) -> usize {
+        let light_choice = |table: &AliasTable| table.len() * 12;
         self.by_cell
             .values()
-            .flatten()
-            .map(EnvironmentGuide::memory_bytes)
+            .map(|guide| {
+                guide
+                    .environment
+                    .as_ref()
+                    .map_or(0, EnvironmentGuide::memory_bytes)
+                    + guide.lights.as_ref().map_or(0, light_choice)
+            })
             .sum::<usize>()
-            + self.by_cell.capacity() * std::mem::size_of::<(CellIndex, Option<EnvironmentGuide>)>()
+            + self.by_cell.capacity() * std::mem::size_of::<(CellIndex, CellGuide)>()
     }
+}
+
+/// The choice among the lights in `cell`: each light's power share `power[l]` and, with
+/// share `fraction`, that share weighed by the visibility of the rays the cell aimed at it
+/// (a light it aimed no ray at counts as the cell's visibility). `None` where the field
+/// counts no lights, the cell has too little evidence, or no light is much less visible
+/// than the others (then the choice by power is as good).
+fn light_choice(power: &[f64], cell: &FieldCell, fraction: f64) -> Option<AliasTable> {
+    if power.is_empty() || cell.total().traced < LEAST_EVIDENCE {
+        return None;
+    }
+    let visibility = cell.visibility();
+    let seen: Vec<f64> = (0..power.len())
+        .map(|light| cell.source_visibility(light).unwrap_or(visibility) as f64)
+        .collect();
+    let free: f64 = power.iter().zip(&seen).map(|(p, v)| p * v).sum();
+    let contrast = power
+        .iter()
+        .zip(&seen)
+        .any(|(&p, &v)| p > 0.0 && v < GUIDE_CONTRAST as f64 * free);
+    if !(free > 0.0 && contrast) {
+        return None;
+    }
+    let weights: Vec<f64> = power
+        .iter()
+        .zip(&seen)
+        .map(|(p, v)| (1.0 - fraction) * p + fraction * p * v / free)
+        .collect();
+    Some(AliasTable::new(&weights))
 }
 
 /// The guide of `cell`: each texel weighed by its learned visibility; texels no ray of the
