@@ -21,8 +21,8 @@
 
 use crate::lights::{Environment, EnvironmentGuide, EnvironmentPartition, GuideLayout};
 use crate::world::World;
-use ais::sampling::AliasTable;
 use ais::field::{CellIndex, FieldCell, LEAST_EVIDENCE, LOWEST_ACCEPTANCE};
+use ais::sampling::AliasTable;
 use std::collections::HashMap;
 use std::sync::Arc;
 

@@ -132,11 +132,9 @@ impl<P: BatchProbe> GatherTile<P> {
             guide: None,
             field: learning.field.clone(),
             // What the last pass of a render observes would never be used.
-            observations: (field && tile.learns)
-                .then(|| {
-                    FieldObservations::new(learning.field.side())
-                        .with_sources(learning.field.sources())
-                }),
+            observations: (field && tile.learns).then(|| {
+                FieldObservations::new(learning.field.side()).with_sources(learning.field.sources())
+            }),
             field_gathers: [0; 2],
             field_guided: 0,
             field_guides: (field && settings.map_use.guides()).then(|| {
