@@ -475,6 +475,17 @@ fn views() -> Vec<(ShadingFrame, Vec3)> {
         .collect()
 }
 
+/// Each of [`views`], and its mirror image through the surface (seen from inside).
+fn views_from_both_sides() -> Vec<(ShadingFrame, Vec3)> {
+    views()
+        .into_iter()
+        .flat_map(|(frame, wo)| {
+            let below = wo - 2.0 * frame.normal * wo.dot(frame.normal);
+            [(frame, wo), (frame, below)]
+        })
+        .collect()
+}
+
 /// Asserts that `material`'s samples fit its density seen from each of `views` (seeds from
 /// `seed` on). Samples that come back with density 0 (a specular lobe picked, or none) are
 /// missing mass, which the density accounts for.
@@ -659,13 +670,7 @@ fn rough_dielectric_sampling_fits_from_both_sides() {
         Microfacet::anisotropic(MicrofacetKind::Ggx, 0.15, 0.45),
     ] {
         // Each view, and its mirror image through the surface (seen from inside).
-        let both_sides: Vec<(ShadingFrame, Vec3)> = views()
-            .into_iter()
-            .flat_map(|(frame, wo)| {
-                let below = wo - 2.0 * frame.normal * wo.dot(frame.normal);
-                [(frame, wo), (frame, below)]
-            })
-            .collect();
+        let both_sides = views_from_both_sides();
         let label = format!("rough glass, {microfacet:?}");
         assert_sampling_fits(&rough_glass(microfacet), 60, &both_sides, &label);
     }
@@ -875,13 +880,7 @@ fn principled_sampling_fits_from_both_sides() {
         clearcoat_gloss: 0.4,
         ..Principled::default()
     };
-    let both_sides: Vec<(ShadingFrame, Vec3)> = views()
-        .into_iter()
-        .flat_map(|(frame, wo)| {
-            let below = wo - 2.0 * frame.normal * wo.dot(frame.normal);
-            [(frame, wo), (frame, below)]
-        })
-        .collect();
+    let both_sides = views_from_both_sides();
     assert_sampling_fits(&principled(rich), 80, &both_sides, "principled, every lobe");
     let plain = principled(Principled::default());
     assert_sampling_fits(&plain, 90, &views(), "principled, defaults");
@@ -903,13 +902,7 @@ fn principled_thin_sampling_fits_from_both_sides() {
         }),
         two_sided: true,
     };
-    let both_sides: Vec<(ShadingFrame, Vec3)> = views()
-        .into_iter()
-        .flat_map(|(frame, wo)| {
-            let below = wo - 2.0 * frame.normal * wo.dot(frame.normal);
-            [(frame, wo), (frame, below)]
-        })
-        .collect();
+    let both_sides = views_from_both_sides();
     assert_sampling_fits(&thin, 100, &both_sides, "principledthin");
 }
 

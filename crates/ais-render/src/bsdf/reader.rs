@@ -177,6 +177,14 @@ fn index_of_refraction(
     }
 }
 
+/// Whether `plugin` gives parameter `name`: as a property, a nested element or a `<ref>`.
+fn gives(plugin: &Plugin, name: &str) -> bool {
+    let named = |n: &Option<String>| n.as_deref() == Some(name);
+    plugin.properties.contains_key(name)
+        || plugin.children.iter().any(|c| named(&c.name))
+        || plugin.references.iter().any(|r| named(&r.0))
+}
+
 /// Indices of refraction of common dielectrics at about 589 nm.
 fn named_index_of_refraction(material: &str) -> Option<f64> {
     Some(match material.to_ascii_lowercase().as_str() {
@@ -391,18 +399,7 @@ impl BsdfReader<'_> {
     /// A conductor's complex index of refraction: `eta` and `k`, or a named `material`.
     fn conductor_ior(&mut self) -> (Vec3, Vec3) {
         let plugin = self.plugin;
-        let given = |name: &str| {
-            plugin.properties.contains_key(name)
-                || plugin
-                    .children
-                    .iter()
-                    .any(|c| c.name.as_deref() == Some(name))
-                || plugin
-                    .references
-                    .iter()
-                    .any(|r| r.0.as_deref() == Some(name))
-        };
-        if given("eta") || given("k") {
+        if gives(plugin, "eta") || gives(plugin, "k") {
             return (self.colour("eta", Vec3::ZERO), self.colour("k", Vec3::ONE));
         }
         match plugin.string("material") {
@@ -551,17 +548,6 @@ impl BsdfReader<'_> {
     /// nudges where light passes through (η = 1 becomes 1.001, `specular` 0 becomes 0.001).
     fn principled(&mut self) -> Result<Material, InputError> {
         let plugin = self.plugin;
-        let has = |name: &str| {
-            plugin.properties.contains_key(name)
-                || plugin
-                    .children
-                    .iter()
-                    .any(|c| c.name.as_deref() == Some(name))
-                || plugin
-                    .references
-                    .iter()
-                    .any(|r| r.0.as_deref() == Some(name))
-        };
         if plugin.properties.contains_key("eta") && plugin.properties.contains_key("specular") {
             return Err(InputError::at(
                 self.file,
@@ -598,7 +584,7 @@ impl BsdfReader<'_> {
             plugin.properties.get("spec_trans").map(|p| &p.value),
             Some(Property::Float(v)) if *v == 0.0
         );
-        let transmits = has("spec_trans") && !zero;
+        let transmits = gives(plugin, "spec_trans") && !zero;
         principled.eta = if plugin.properties.contains_key("eta") {
             let eta = self.positive("eta", 1.5);
             if transmits && eta == 1.0 {
