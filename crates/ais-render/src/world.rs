@@ -308,6 +308,46 @@ fn build_shape(
     Ok(BuiltShape { input, light })
 }
 
+/// Every shape of a scene, ready for the BVH: the scene's own, then each shape group's (in
+/// the group's frame), numbered in that order.
+struct BuiltShapes {
+    /// The scene's shapes, then one set per group.
+    sets: Vec<Vec<ShapeInput>>,
+    area_lights: Vec<AreaLight>,
+    surfaces: ShapeSurfaces,
+    /// Shapes in all.
+    count: usize,
+}
+
+/// Loads, transforms and checks every shape of `description`, with its surface and light.
+fn build_shapes(
+    description: &SceneDescription,
+    warnings: &mut Vec<String>,
+) -> Result<BuiltShapes, InputError> {
+    let mut built = BuiltShapes {
+        sets: Vec::new(),
+        area_lights: Vec::new(),
+        surfaces: ShapeSurfaces::default(),
+        count: 0,
+    };
+    let grouped = (description.shape_groups.iter()).map(|group| group.shapes.iter());
+    for shapes in std::iter::once(description.shapes.iter()).chain(grouped) {
+        let mut inputs = Vec::with_capacity(shapes.len());
+        for shape in shapes {
+            let index = built.count;
+            built.surfaces.add(description, shape, warnings)?;
+            let one = build_shape(description, shape, index as u32, warnings)?;
+            let surface = &built.surfaces.per_shape[index];
+            check_attributes(&description.file, shape, &one.input, surface)?;
+            inputs.push(one.input);
+            built.area_lights.extend(one.light);
+            built.count += 1;
+        }
+        built.sets.push(inputs);
+    }
+    Ok(built)
+}
+
 impl World {
     /// Renders at `resolution` from now on: the film's size and the camera's aspect.
     pub fn set_resolution(&mut self, resolution: (u32, u32)) {
@@ -319,31 +359,13 @@ impl World {
     pub fn from_description(description: SceneDescription) -> Result<Self, InputError> {
         let mut warnings = description.warnings.clone();
         let file = description.file.clone();
-        let mut area_lights = Vec::new();
-        let mut surfaces = ShapeSurfaces::default();
-        // The scene's shapes, then each group's (in its own frame), numbered in that order.
-        let grouped = (description.shape_groups.iter()).map(|group| group.shapes.iter());
-        let placements = std::iter::once(description.shapes.iter()).chain(grouped);
-        let mut built_sets: Vec<Vec<ShapeInput>> = Vec::new();
-        let mut index = 0u32;
-        for shapes in placements {
-            let mut inputs = Vec::with_capacity(shapes.len());
-            for shape in shapes {
-                surfaces.add(&description, shape, &mut warnings)?;
-                let built = build_shape(&description, shape, index, &mut warnings)?;
-                check_attributes(
-                    &file,
-                    shape,
-                    &built.input,
-                    &surfaces.per_shape[index as usize],
-                )?;
-                inputs.push(built.input);
-                area_lights.extend(built.light);
-                index += 1;
-            }
-            built_sets.push(inputs);
-        }
-        let triangles = (built_sets.iter().flatten())
+        let BuiltShapes {
+            sets,
+            area_lights,
+            surfaces,
+            count,
+        } = build_shapes(&description, &mut warnings)?;
+        let triangles = (sets.iter().flatten())
             .map(|input| match &input.geometry {
                 ShapeGeometry::Mesh(mesh) => mesh.triangles.len(),
                 ShapeGeometry::Sphere(_) | ShapeGeometry::Quadric(_) => 1,
@@ -351,7 +373,7 @@ impl World {
             .sum();
         crate::limits::check_geometry_memory(triangles)
             .map_err(|message| InputError::new(&file, message))?;
-        let mut sets = built_sets.into_iter();
+        let mut sets = sets.into_iter();
         let geometry = Geometry::build_instanced(SceneShapes {
             shapes: sets.next().unwrap_or_default(),
             groups: sets.map(|shapes| ShapeGroupInput { shapes }).collect(),
@@ -375,7 +397,7 @@ impl World {
             area: area_lights,
             delta,
         };
-        let lights = Lights::new(emitters, index as usize, radius.max(1e-3) as f64);
+        let lights = Lights::new(emitters, count, radius.max(1e-3) as f64);
         let (width, height) = description.resolution;
         Ok(World {
             geometry,
