@@ -228,7 +228,7 @@ fn every_unread_input_is_named_and_strict_refuses_it() {
 <sampler type="independent"><integer name="sample_cont" value="8"/></sampler></sensor>
 <emitter type="constant" foo="bar"><float name="scael" value="2"/></emitter>
 <shape type="sphere"><bsdf type="diffuse"><rgb name="reflectanse" value="0.3"/></bsdf></shape>
-<shape type="sphere"><point name="center" x="3" y="0" z="0"/><bsdf type="roughconductor"><float name="alpah" value="0.3"/><texture type="checkerboard" name="eta"/></bsdf></shape></scene>"#;
+<shape type="sphere"><point name="center" x="3" y="0" z="0"/><bsdf type="roughplastic"><float name="alpah" value="0.3"/><texture type="checkerboard" name="alpha"/></bsdf></shape></scene>"#;
     let path = dir.join("scene.xml");
     std::fs::write(&path, text).unwrap();
     let path = path.to_str().unwrap();
@@ -242,7 +242,7 @@ fn every_unread_input_is_named_and_strict_refuses_it() {
         r#"scene.xml:5: attribute "foo" of <emitter>"#,
         r#"scene.xml:5: property "scael" of emitter"#,
         r#"scene.xml:6: property "reflectanse" of bsdf"#,
-        "scene.xml:7: textures are not supported: eta",
+        "scene.xml:7: textures are not supported: alpha",
         r#"scene.xml:7: property "alpah" of bsdf"#,
         "-D nosuch=3 is not used",
     ] {
