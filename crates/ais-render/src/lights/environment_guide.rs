@@ -251,10 +251,9 @@ impl PartitionCache {
 #[derive(Clone, Debug)]
 pub struct EnvironmentGuide {
     partition: Arc<EnvironmentPartition>,
-    /// Per batch: the affinity of each texel, the texels drawn in proportion to
-    /// `A_t P_t / Z` (an alias table: O(1), no search), and `Z`.
+    /// Per batch: the affinity of each texel, the cumulative of `A_t P_t / Z`, and `Z`.
     affinity: Vec<f32>,
-    texels: AliasTable,
+    cdf: Vec<f64>,
     normaliser: f64,
     /// The product's share β of the defensive mixture `(1 − β) p_env + β p_env A / Z`.
     fraction: f64,
@@ -268,7 +267,7 @@ impl EnvironmentGuide {
         let mut guide = EnvironmentGuide {
             partition,
             affinity: vec![1.0; texels],
-            texels: AliasTable::new(&[1.0]),
+            cdf: vec![0.0; texels + 1],
             normaliser: 1.0,
             fraction: 1.0,
         };
@@ -279,7 +278,7 @@ impl EnvironmentGuide {
     /// Bytes held by this thread's part (the shared partition is counted once, in
     /// [`EnvironmentPartition::memory_bytes`]).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(self) + 4 * self.affinity.len() + 12 * self.texels.len()
+        std::mem::size_of_val(self) + 4 * self.affinity.len() + 8 * self.cdf.len()
     }
 
     /// The layout the cells are grouped by.
@@ -292,22 +291,24 @@ impl EnvironmentGuide {
     /// non-finite values count as 0; if no texel with environment mass is left, all count
     /// as 1).
     pub fn set_affinities(&mut self, affinity: impl Fn(usize) -> f32) {
-        for (t, slot) in self.affinity.iter_mut().enumerate() {
+        let mut running = 0.0;
+        for t in 0..self.affinity.len() {
             let a = affinity(t);
-            *slot = if a.is_finite() && a > 0.0 { a } else { 0.0 };
+            self.affinity[t] = if a.is_finite() && a > 0.0 { a } else { 0.0 };
+            running += self.affinity[t] as f64 * self.partition.texel_mass[t];
+            self.cdf[t + 1] = running;
         }
-        let mass = &self.partition.texel_mass;
-        let mut weights: Vec<f64> = (self.affinity.iter().zip(mass))
-            .map(|(&a, &m)| a as f64 * m)
-            .collect();
-        let mut total: f64 = weights.iter().sum();
-        if total <= 0.0 {
+        if running <= 0.0 {
             self.affinity.fill(1.0);
-            weights.copy_from_slice(mass);
-            total = weights.iter().sum();
+            running = 0.0;
+            for t in 0..self.affinity.len() {
+                running += self.partition.texel_mass[t];
+                self.cdf[t + 1] = running;
+            }
         }
-        self.normaliser = total;
-        self.texels = AliasTable::new(&weights);
+        self.normaliser = running;
+        self.cdf.iter_mut().for_each(|c| *c /= running);
+        *self.cdf.last_mut().expect("at least one texel") = 1.0;
     }
 
     /// How much more often the mixture draws texel `t` than the environment alone:
@@ -331,7 +332,14 @@ impl EnvironmentGuide {
             let rescaled = ((u0 - beta) / (1.0 - beta)).clamp(0.0, 1.0 - 1e-7);
             return environment.sample_toward([rescaled as f32, u[1]]);
         }
-        let (t, v) = self.texels.sample((u0 / beta) as f32);
+        let u0 = u0 / beta;
+        let texels = self.affinity.len();
+        let mut t = self.cdf[1..].partition_point(|&c| c <= u0).min(texels - 1);
+        while t > 0 && self.cdf[t + 1] <= self.cdf[t] {
+            t -= 1; // rounding at u ≈ 1: back to a texel with mass
+        }
+        let share = self.cdf[t + 1] - self.cdf[t];
+        let v = ((u0 - self.cdf[t]) / share).clamp(0.0, 1.0) as f32;
         self.partition.sample_in_texel(environment, t, v, u[1])
     }
 
