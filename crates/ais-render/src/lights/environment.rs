@@ -9,10 +9,12 @@
 //!
 //! Sampling is piecewise constant in solid angle over the cells between four neighbouring
 //! texel centres, each weighted by the mean luminance of its corners times its solid angle,
-//! so the density is positive wherever the interpolated radiance is. Both the row and the
-//! cell within it are drawn by alias tables ([`AliasGrid`]), and each cell's density is
-//! stored, so that a sample, a density and a radiance lookup each cost O(1) whatever the
-//! image size. A sample knows its cell and its (u, v), and a [`Toward`] carries them to the
+//! so the density is positive wherever the interpolated radiance is. The row and the cell
+//! within it are drawn by inversion of their cumulative distributions ([`CdfGrid`]: two
+//! binary searches, which keep a gather's stratified numbers stratified over the sky, where
+//! alias tables scattered them and cost 24–36% in relMSE), and each cell's density is
+//! stored, so that a density and a radiance lookup each cost O(1) whatever the image
+//! size. A sample knows its cell and its (u, v), and a [`Toward`] carries them to the
 //! density and radiance lookups; a direction from elsewhere (BSDF sampling) is located on the
 //! map once. Like Mitsuba's RGB variants, all of it is f32; directions are located with
 //! [`fast_trig`], within 4e-7 rad of libm.
@@ -20,7 +22,7 @@
 use super::Toward;
 use crate::image_io::RgbImage;
 use ais::fast_trig;
-use ais::sampling::{uniform_sphere, AliasGrid};
+use ais::sampling::{uniform_sphere, CdfGrid};
 use glam::{DMat3, Mat3, Vec3};
 use std::f32::consts::PI as PI32;
 use std::f64::consts::PI;
@@ -47,7 +49,7 @@ pub struct EnvironmentMap {
     to_local: Mat3,
     /// The `width × (height − 1)` cells by probability (row-major). Cell (c, r) has texel
     /// centres (c, r) and (c + 1, r + 1) at its corners.
-    cells: AliasGrid,
+    cells: CdfGrid,
     /// The sampling density of each cell in solid angle (row-major, `width × (height − 1)`).
     cell_density: Vec<f32>,
     /// cos θ of each texel row.
@@ -95,7 +97,7 @@ impl EnvironmentMap {
             })
             .collect();
         EnvironmentMap {
-            cells: AliasGrid::new(&weights, width),
+            cells: CdfGrid::new(&weights, width),
             cell_density,
             to_local: to_world.inverse().as_mat3(),
             to_world: to_world.as_mat3(),

@@ -15,7 +15,7 @@
 use super::{Environment, EnvironmentMap, Toward};
 use ais::field::octahedral;
 use ais::mapping::LatLong;
-use ais::sampling::AliasTable;
+use ais::sampling::{cumulative, invert_cumulative};
 use glam::Vec3;
 use std::sync::{Arc, Mutex};
 
@@ -62,8 +62,10 @@ enum TexelContents {
         /// Environment cells grouped by texel: texel `t` owns `cells[start[t]..start[t + 1]]`.
         cells: Vec<u32>,
         start: Vec<u32>,
-        /// Per texel, its cells in proportion to their probabilities (O(1) draws).
-        within: Vec<AliasTable>,
+        /// Per texel, the cumulative probabilities of its cells within it: texel `t`'s are
+        /// `within[start[t] + t..][..n_t + 1]` with `n_t` its cells (drawn by inversion,
+        /// which keeps stratified numbers stratified).
+        within: Vec<f64>,
     },
     /// A constant environment's uniform directions over equal-area octahedral texels: a
     /// point uniform in the texel's square is uniform over its solid angle.
@@ -104,7 +106,7 @@ impl EnvironmentPartition {
             cells[fill[t as usize] as usize] = cell as u32;
             fill[t as usize] += 1;
         }
-        let mut within = Vec::with_capacity(texels);
+        let mut within = Vec::with_capacity(cells.len() + texels);
         let mut texel_mass = vec![0.0; texels];
         for t in 0..texels {
             let range = start[t] as usize..start[t + 1] as usize;
@@ -113,7 +115,13 @@ impl EnvironmentPartition {
                 .map(|&cell| environment.cell_probability(cell as usize))
                 .collect();
             texel_mass[t] = probabilities.iter().sum();
-            within.push(AliasTable::new(&probabilities));
+            if texel_mass[t] > 0.0 {
+                within.extend(cumulative(&probabilities, texel_mass[t]));
+            } else {
+                // Never drawn (no mass); any valid table will do.
+                let n = probabilities.len().max(1) as f64;
+                within.extend((0..=probabilities.len()).map(|k| k as f64 / n));
+            }
         }
         EnvironmentPartition {
             layout,
@@ -159,11 +167,7 @@ impl EnvironmentPartition {
                 cells,
                 start,
                 within,
-            } => {
-                4 * (cell_texel.len() + cells.len() + start.len())
-                    + 12 * cells.len()
-                    + std::mem::size_of::<AliasTable>() * within.len()
-            }
+            } => 4 * (cell_texel.len() + cells.len() + start.len()) + 8 * within.len(),
             TexelContents::Uniform { .. } => 0,
         };
         std::mem::size_of_val(self) + cells + 8 * self.texel_mass.len()
@@ -182,7 +186,9 @@ impl EnvironmentPartition {
                 },
                 Environment::Map(map),
             ) => {
-                let (i, fx) = within[t].sample(v);
+                let first = start[t] as usize + t;
+                let count = (start[t + 1] - start[t]) as usize;
+                let (i, fx) = invert_cumulative(&within[first..first + count + 1], v as f64);
                 let cell = cells[start[t] as usize + i] as usize;
                 map.toward_in_cell(cell, [fx, w.min(ONE_BELOW)])
             }

@@ -3,8 +3,8 @@
 //!
 //! All the rows' tables sit in one block, row after row, so a draw makes two dependent table
 //! reads, not four (as a table per row, each behind its own pointer, would). This is the
-//! layout an environment map's importance sampling wants: thousands of cells, drawn once per
-//! candidate direction.
+//! layout for thousands of cells drawn once per sample. It suits independent random numbers:
+//! it scatters stratified ones over the grid (see [`super::CdfGrid`], which keeps them).
 
 use super::alias::{build_bins, draw, AliasBin};
 use super::AliasTable;

@@ -2,7 +2,9 @@
 //! - [`warp`]: the unit square to directions (uniform sphere, cosine hemisphere);
 //! - [`alias`]: a discrete distribution sampled in O(1) (Walker's alias method);
 //! - [`alias_grid`]: a distribution over a grid's cells, a row then a column by alias tables
-//!   kept in one block (an environment map's cells);
+//!   kept in one block (O(1), for independent random numbers);
+//! - [`cdf_grid`]: the same by inversion, which keeps stratified numbers stratified (an
+//!   environment map's cells);
 //! - [`distribution`]: piecewise-constant densities in one and two dimensions (the
 //!   environment map's importance sampling);
 //! - [`texel_distribution`]: a piecewise-constant density over a lat-long map's texels, to
@@ -10,12 +12,14 @@
 
 pub mod alias;
 pub mod alias_grid;
+pub mod cdf_grid;
 pub mod distribution;
 pub mod texel_distribution;
 pub mod warp;
 
 pub use alias::AliasTable;
 pub use alias_grid::AliasGrid;
+pub use cdf_grid::{cumulative, invert_cumulative, CdfGrid};
 pub use distribution::{Distribution1D, Distribution2D};
 pub use texel_distribution::TexelDistribution;
 pub use warp::{cosine_hemisphere, uniform_sphere};
