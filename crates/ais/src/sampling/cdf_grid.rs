@@ -3,8 +3,8 @@
 //!
 //! Inversion is monotone: neighbouring uniform numbers give neighbouring rows, and within a
 //! row neighbouring cells, so stratified or low-discrepancy numbers (a gather's Halton
-//! points) stay spread over the grid as they are spread over the square. An alias table
-//! ([`super::AliasGrid`]) draws in O(1) but scatters them: measured on an environment map
+//! points) stay spread over the grid as they are spread over the square. Alias tables (a
+//! row's, then a cell's) draw in O(1) but scatter them: measured on an environment map
 //! under an open sky, its relMSE was 24–36% higher than this grid's at the same samples
 //! (the repository's BENCHMARKS.md). A draw here is two searches, each started from a
 //! guide table (the bin holding k / n for every k of n bins), so that it usually looks at
