@@ -380,4 +380,17 @@ fn print_gather_summary(
             rendered.output.stats.field_cost_ratio
         );
     }
+    if let Some(race) = rendered.output.stats.field_race {
+        println!(
+            "field race   pixel variance with the field {:.3e}, AIS off {:.3e} (ratio {:.3}): {}",
+            race.field,
+            race.off,
+            race.field / race.off,
+            if race.field_pays() {
+                "the field guides the rest"
+            } else {
+                "the rest gathers as AIS off"
+            }
+        );
+    }
 }

@@ -29,11 +29,21 @@ fn render_with(world: &World, integrator: Integrator, spp: u32) -> RenderOutput<
 
 /// Renders `integrator` on `world` with 2 spp on a pool of `threads` threads.
 fn on_threads(world: &World, threads: usize, integrator: Integrator) -> RenderOutput<GatherStats> {
+    on_threads_at(world, threads, integrator, 2)
+}
+
+/// [`on_threads`] with `spp` samples per pixel.
+fn on_threads_at(
+    world: &World,
+    threads: usize,
+    integrator: Integrator,
+    spp: u32,
+) -> RenderOutput<GatherStats> {
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap()
-        .install(|| render_with(world, integrator, 2))
+        .install(|| render_with(world, integrator, spp))
 }
 
 fn bits(image: &ais_render::image_io::RgbImage) -> Vec<u32> {
@@ -214,6 +224,60 @@ fn the_default_gather_guides_without_timing_and_is_reproducible() {
         one.stats.ais.rejected_roulette, 0,
         "nothing is rolled at n = 16"
     );
+}
+
+#[test]
+fn the_race_of_the_field_against_ais_off_is_reproducible() {
+    // 8 spp: passes of 1, 1, 2 and 4 samples; the second and third race the field against
+    // AIS off on a checkerboard of pixels, and the last follows the verdict. The race
+    // reads sample values only: same image at any thread count.
+    let world = interior(48, 27);
+    let auto = Integrator::Gather(GatherSettings::default());
+    let one = on_threads_at(&world, 1, auto, 8);
+    let two = on_threads_at(&world, 2, auto, 8);
+    assert_eq!(bits(&one.image), bits(&two.image));
+    let race = one.stats.field_race.expect("the default gather raced");
+    assert_eq!(Some(race), two.stats.field_race);
+    assert!(race.field > 0.0 && race.off > 0.0, "{race:?}");
+}
+
+/// A learning whose race passes saw every pixel's two samples at 1 ± `spread(x, y)`.
+fn raced(world: &World, spread: impl Fn(usize, usize) -> f32) -> gather::GatherLearning {
+    use ais_render::integrators::gather::race::TileMoments;
+    use ais_render::render::Learning;
+    let mut learning = gather::GatherLearning::new(world, &GatherSettings::default());
+    let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
+    let rect = PixelRect::whole(width, height);
+    for pass in 0..3 {
+        let mut moments = TileMoments::new(rect);
+        for (x, y) in rect.pixels() {
+            moments.begin_pixel(x, y);
+            moments.sampled([1.0 - spread(x, y); 3]);
+            moments.sampled([1.0 + spread(x, y); 3]);
+        }
+        learning.merge(Some(gather::FieldPass {
+            observations: ais::field::FieldObservations::new(learning.field.side()),
+            cost: Default::default(),
+            guided: [1, 1],
+            moments: (pass > 0).then_some(moments),
+        }));
+        learning.end_pass();
+    }
+    learning
+}
+
+#[test]
+fn a_field_that_loses_its_race_stands_aside_for_the_rest() {
+    use ais_render::integrators::gather::race::races_off;
+    use ais_render::render::Learning;
+    let world = interior(16, 8);
+    // The field's pixels are quieter: it guides the rest, and learning goes on.
+    let wins = raced(&world, |x, y| if races_off(x, y) { 0.5 } else { 0.2 });
+    assert!(wins.race_result().unwrap().field_pays());
+    assert!(!wins.stands_aside() && wins.keeps_learning());
+    // AIS off's pixels are quieter: the rest gathers as AIS off, and learning stops.
+    let loses = raced(&world, |x, y| if races_off(x, y) { 0.2 } else { 0.5 });
+    assert!(loses.stands_aside() && !loses.keeps_learning());
 }
 
 #[test]

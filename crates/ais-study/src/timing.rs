@@ -149,6 +149,14 @@ impl TileState for TimedTile {
         self.0.work()
     }
 
+    fn begin_pixel(&mut self, x: usize, y: usize) {
+        self.0.begin_pixel(x, y);
+    }
+
+    fn sampled(&mut self, value: [f32; 3]) {
+        self.0.sampled(value);
+    }
+
     fn finish(self) -> TimedStats {
         let ais_time = self.0.probe.estimate();
         TimedStats {

@@ -52,6 +52,18 @@ impl TileState for IntegratorTile {
         }
     }
 
+    fn begin_pixel(&mut self, x: usize, y: usize) {
+        if let IntegratorTile::Gather(state) = self {
+            state.begin_pixel(x, y);
+        }
+    }
+
+    fn sampled(&mut self, value: [f32; 3]) {
+        if let IntegratorTile::Gather(state) = self {
+            state.sampled(value);
+        }
+    }
+
     fn finish(self) -> GatherStats {
         match self {
             IntegratorTile::Gather(state) => state.finish(),

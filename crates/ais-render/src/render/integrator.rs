@@ -58,6 +58,13 @@ pub trait TileState {
         0
     }
 
+    /// Pixel (`x`, `y`) of the image begins: the camera samples that follow are its own,
+    /// until the next call.
+    fn begin_pixel(&mut self, _x: usize, _y: usize) {}
+
+    /// The value of the current pixel's latest camera sample.
+    fn sampled(&mut self, _value: [f32; 3]) {}
+
     /// The tile's statistics.
     fn finish(self) -> Self::Stats;
 }

@@ -291,6 +291,7 @@ fn render_tile<I: SampleIntegrator>(
     for (x, y) in tile.rect.pixels() {
         let mut rng = Pcg32::new(pass.pixel_seed(tile.seed, x, y, width), 0);
         let work_before = state.work();
+        state.begin_pixel(x, y);
         let mut sum = [0.0f64; 3];
         for _ in 0..spp {
             let position = [x as f32 + rng.next_f32(), y as f32 + rng.next_f32()];
@@ -303,6 +304,7 @@ fn render_tile<I: SampleIntegrator>(
                 world.camera.ray(u, v)
             };
             let value = integrator.radiance(world, &ray, &mut rng, &mut state, &mut counts);
+            state.sampled(value);
             match splats.as_mut() {
                 Some(film) => film.splat(&filter, position, value),
                 None => {

@@ -4,6 +4,7 @@
 
 use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse};
 use super::guiding::CandidateSampler;
+use super::race::{Race, RaceResult, TileMoments, RACE_PASSES};
 use super::strategy::{GatherPoint, Strategy};
 use super::{batch_for, GatherSettings, GatherTile, MapSource};
 use crate::geometry::Hit;
@@ -133,13 +134,17 @@ pub struct FieldPass {
     pub observations: FieldObservations,
     /// Timings of its sampled gathers.
     pub cost: CostSample,
-    /// Its gathers whose light sampling the field guided, and all its gathers with the field.
+    /// Its gathers whose light sampling the field guided, and all its gathers the field
+    /// could guide.
     pub guided: [u64; 2],
+    /// Its pixels' sample moments, in a race pass.
+    pub moments: Option<TileMoments>,
 }
 
-/// Learning goes on, where the field does not roll, only while at least this share of a
-/// pass's gathers were guided: under an open sky the field guides few cells, and its
-/// learning passes (recording, barriers) would cost 11–14% for nothing.
+/// Where the field does not roll, it stands aside for the rest of the render (AIS off)
+/// once a pass guided fewer than this share of the gathers it could guide: under an open
+/// sky the field guides few cells, and its learning passes (recording, barriers) and
+/// lookups would cost 6–14% for nothing.
 pub const LEAST_GUIDED_SHARE: f64 = 0.05;
 
 /// What the gather learns between passes: the visibility field and the measured costs.
@@ -159,6 +164,10 @@ pub struct GatherLearning {
     guided_share: Option<f64>,
     /// Passes ended.
     passes: u32,
+    /// The field against AIS off on the image.
+    race: Race,
+    /// The race's result, once its passes ended.
+    race_result: Option<RaceResult>,
 }
 
 impl GatherLearning {
@@ -176,7 +185,31 @@ impl GatherLearning {
             guided: [0; 2],
             guided_share: None,
             passes: 0,
+            race: Race::new(world.resolution.0 as usize, world.resolution.1 as usize),
+            race_result: None,
         }
+    }
+
+    /// Passes ended so far (the index of the pass about to run).
+    pub fn passes_ended(&self) -> u32 {
+        self.passes
+    }
+
+    /// The race's result, once its passes ended.
+    pub fn race_result(&self) -> Option<RaceResult> {
+        self.race_result
+    }
+
+    /// Whether the field has no use in the rest of the render, which then gathers as AIS
+    /// off: it lost its race, or, where it does not roll, its last pass guided fewer than
+    /// [`LEAST_GUIDED_SHARE`] of the gathers it could guide.
+    pub fn stands_aside(&self) -> bool {
+        let lost_race = self.race_result.is_some_and(|race| !race.field_pays());
+        let guides_little = !self.rolls
+            && self
+                .guided_share
+                .is_some_and(|share| share < LEAST_GUIDED_SHARE);
+        lost_race || guides_little
     }
 
     /// The cost ratio the next pass uses: the settings' `cost_ratio` if given, else the one
@@ -198,6 +231,9 @@ impl Learning for GatherLearning {
             self.cost.add(pass.cost);
             self.guided[0] += pass.guided[0];
             self.guided[1] += pass.guided[1];
+            if let Some(moments) = &pass.moments {
+                self.race.merge(moments);
+            }
         }
     }
 
@@ -210,23 +246,26 @@ impl Learning for GatherLearning {
             self.guided_share = Some(self.guided[0] as f64 / self.guided[1] as f64);
         }
         self.guided = [0; 2];
+        if self.passes == *RACE_PASSES.end() {
+            self.race_result = self.race.result();
+            self.race = Race::default(); // its image-sized sums are no longer needed
+        }
         self.passes += 1;
     }
 
-    /// Learning goes on unless the field's roulette, with enough evidence, stands aside
-    /// for nearly every ray (the talk's auto-disable): then the rest of the render is one
-    /// pass. Gathers that do not roll learn for the guides while a pass guides at least
-    /// [`LEAST_GUIDED_SHARE`] of its gathers (counts, not timings: their images do not
-    /// depend on the machine).
+    /// Learning goes on unless the field stands aside ([`GatherLearning::stands_aside`]:
+    /// counts and sample values, not timings, so those images do not depend on the
+    /// machine) or its roulette, with enough evidence, stands aside for nearly every ray
+    /// (the talk's auto-disable): then the rest of the render is one pass.
     fn keeps_learning(&self) -> bool {
-        if !self.rolls {
-            return self
-                .guided_share
-                .is_none_or(|share| share >= LEAST_GUIDED_SHARE);
+        if self.stands_aside() {
+            return false;
         }
-        self.field
-            .rolling_share()
-            .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
+        !self.rolls
+            || self
+                .field
+                .rolling_share()
+                .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
     }
 }
 
@@ -320,8 +359,14 @@ pub(super) fn field_gather<P: BatchProbe>(
         cost,
         gathers,
         probe,
+        race,
+        racing_off,
+        raced_off,
         ..
     } = state;
+    // A pixel racing as AIS off records its rays but is not guided (see `race`).
+    let racing_off = race.is_some() && *racing_off;
+    *raced_off += u64::from(racing_off);
     let cost_ratio = *cost_ratio;
     let known = find_cell(field, last_cell, site.key);
     let record = known.is_none_or(|(_, cell)| cell.total().traced < WELL_KNOWN)
@@ -331,7 +376,8 @@ pub(super) fn field_gather<P: BatchProbe>(
         .map(|(_, cell)| cell)
         .filter(|cell| rolls && cell.worth_rolling(cost_ratio));
     let mut at: GatherPoint<'_> = site.at;
-    if let (Some(guides), Some((index, cell))) = (field_guides.as_mut(), known) {
+    let guides = field_guides.as_mut().filter(|_| !racing_off);
+    if let (Some(guides), Some((index, cell))) = (guides, known) {
         let guide = guides.guide(index, &cell);
         at.receiver.environment_guide = guide.environment.as_ref();
         at.receiver.light_choice = guide.lights.as_ref();

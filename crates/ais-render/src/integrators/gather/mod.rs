@@ -9,7 +9,9 @@
 //!   recent gathers of [`ais::shared`], the sources of shared maps);
 //! - [`guiding`]: a fixed map folded into the proposal;
 //! - [`field`]: acceptance from the visibility field learned between passes (`ais auto`);
-//! - [`field_guide`]: light sampling guided by that field.
+//! - [`field_guide`]: light sampling guided by that field;
+//! - [`race`]: the field raced against AIS off on the image, to stand aside where it
+//!   does not pay.
 
 pub mod acceptance;
 pub mod batch_loop;
@@ -18,6 +20,7 @@ pub mod field_guide;
 pub mod guiding;
 pub mod learning_pass;
 mod light;
+pub mod race;
 pub mod settings;
 pub mod strategy;
 
@@ -39,6 +42,7 @@ use field_guide::FieldGuides;
 use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
+use race::{RaceResult, TileMoments};
 use std::sync::Arc;
 
 /// The radius of a gather's neighbourhood among the tile's recent gathers, in pixel
@@ -62,6 +66,8 @@ pub struct GatherStats {
     /// The cost ratio ρ (a candidate's work besides tracing, over tracing's) the field's
     /// acceptance used in the last pass.
     pub field_cost_ratio: f32,
+    /// The race of the field against AIS off, where one was run (see [`race`]).
+    pub field_race: Option<RaceResult>,
 }
 
 impl TileStats for GatherStats {
@@ -74,6 +80,7 @@ impl TileStats for GatherStats {
         }
         self.field_guided += other.field_guided;
         self.field_cost_ratio = self.field_cost_ratio.max(other.field_cost_ratio);
+        self.field_race = self.field_race.or(other.field_race);
     }
 }
 
@@ -109,6 +116,16 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) cost: CostSample,
     /// Gathers run by this tile (to sample the timed ones).
     pub(super) gathers: u64,
+    /// The pixel moments of a race pass (see [`race`]).
+    pub(super) race: Option<TileMoments>,
+    /// Whether the current pixel gathers as AIS off in the race.
+    pub(super) racing_off: bool,
+    /// Gathers that raced as AIS off in this pass.
+    pub(super) raced_off: u64,
+    /// Whether the race found that the field does not pay: every gather runs as AIS off.
+    stands_aside: bool,
+    /// The race's result, once run.
+    race_result: Option<RaceResult>,
     /// What watches the batches.
     pub probe: P,
 }
@@ -125,6 +142,11 @@ impl<P: BatchProbe> GatherTile<P> {
         probe: P,
     ) -> Self {
         let field = settings.map == MapSource::Field;
+        let races = field
+            && tile.learns
+            && field::field_has_use(world, settings)
+            && !field::field_rolls(settings)
+            && race::RACE_PASSES.contains(&learning.passes_ended());
         let mut state = GatherTile {
             batch: None,
             recent: RecentGathers::default(),
@@ -150,6 +172,11 @@ impl<P: BatchProbe> GatherTile<P> {
             cost_ratio: learning.cost_ratio(),
             cost: CostSample::default(),
             gathers: 0,
+            race: races.then(|| TileMoments::new(tile.rect)),
+            racing_off: false,
+            raced_off: 0,
+            stands_aside: learning.stands_aside(),
+            race_result: learning.race_result(),
             probe,
         };
         if let (true, Sharing::LearningPass { stride }) = (settings.shares_maps(), settings.sharing)
@@ -196,11 +223,27 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
 
     fn take_observed(&mut self) -> Option<FieldPass> {
         let observations = self.observations.take()?;
+        let gathers = self.field_gathers.iter().sum::<u64>();
         Some(FieldPass {
             observations,
             cost: std::mem::take(&mut self.cost),
-            guided: [self.field_guided, self.field_gathers.iter().sum::<u64>()],
+            // Gathers racing as AIS off could not be guided.
+            guided: [self.field_guided, gathers - self.raced_off],
+            moments: self.race.take(),
         })
+    }
+
+    fn begin_pixel(&mut self, x: usize, y: usize) {
+        if let Some(race) = self.race.as_mut() {
+            race.begin_pixel(x, y);
+            self.racing_off = race::races_off(x, y);
+        }
+    }
+
+    fn sampled(&mut self, value: [f32; 3]) {
+        if let Some(race) = self.race.as_mut() {
+            race.sampled(value);
+        }
     }
 
     fn finish(self) -> GatherStats {
@@ -215,6 +258,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
             field_gathers: self.field_gathers,
             field_guided: self.field_guided,
             field_cost_ratio: self.cost_ratio,
+            field_race: self.race_result,
         }
     }
 }
@@ -296,7 +340,7 @@ pub fn gather<P: BatchProbe>(
     state: &mut GatherTile<P>,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    let field = field::field_has_use(world, settings);
+    let field = field::field_has_use(world, settings) && !state.stands_aside;
     let started =
         (field && field::times_next_gather(state, settings)).then(std::time::Instant::now);
     counts.closest_hit += 1;

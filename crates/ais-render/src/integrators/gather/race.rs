@@ -1,0 +1,289 @@
+//! The field raced against AIS off on the image itself: whether guiding pays in this
+//! scene, measured where it is judged (the noise of pixels), not predicted from the field.
+//!
+//! Guiding lowers the variance of light sampling within a gather; whether that shows in
+//! the image depends on what else is noisy there. Where pixel sampling dominates (edges,
+//! lights seen directly, foliage at every scale) the guided gathers' extra cost buys
+//! nothing. So in the race passes ([`RACE_PASSES`]) one pixel in four ([`races_off`])
+//! gathers as AIS off and the others with the field; both arms record their rays for the
+//! field alike. Each pixel's samples give an unbiased estimate of its
+//! per-sample variance; weighted as relMSE weighs them (1 / (r² + 0.01), with r the mean
+//! of the 3 × 3 pixels around, both arms), capped at the 99th percentile of both arms
+//! ([`CAP_QUANTILE`]: a few fireflies must not decide) and averaged per arm, they say which
+//! arm's image is less noisy. Neighbouring pixels see the same scene, so the arms differ only in how
+//! they gather.
+//!
+//! The verdict after the race passes keeps the field only if its arm's variance, times
+//! [`RACE_MARGIN`], is below AIS off's; else the rest of the render gathers as AIS off,
+//! with no field work at all. It reads sample values only, merged in a fixed order, so the
+//! image stays the same at any thread count. Choosing how later passes gather from what
+//! earlier passes saw keeps every pass unbiased.
+
+use crate::render::PixelRect;
+use crate::texture::luminance;
+use glam::Vec3;
+
+/// The passes (by index) whose pixels race: the first two that read a field (1 and 2
+/// samples per pixel), so a pixel has 3 samples for its variance.
+pub const RACE_PASSES: std::ops::RangeInclusive<u32> = 1..=2;
+
+/// The field must lower the race's variance by this factor to keep guiding. Two measured
+/// effects meet in it (the repository's BENCHMARKS.md, section 5.6): a guided pass costs
+/// 1.16–1.27 times an AIS-off pass at equal samples in the rooms and the courtyard (guided
+/// candidates draw from a mixture and weigh by both densities, and the free rays they aim
+/// at cross more of the scene); and the race, run on a field learned from 1 and 2 samples
+/// per pixel, overstates the variance that the later, better-taught field gives by 0–20%
+/// (race ratio against final relMSE ratio: sunlit room 0.46 / 0.39, interior 0.90 /
+/// 0.75, courtyard 0.67 / 0.68).
+pub const RACE_MARGIN: f64 = 1.1;
+
+/// Pixels' weighted variances are capped at this quantile of both arms' before the arms
+/// are averaged. Three samples per pixel make the plain mean hostage to a few fireflies:
+/// over four seeds it gave 0.79–1.20 for a room whose relMSE ratio is 0.74; capped, 0.74–0.83
+/// (and within ±0.03 of the plain mean in the other scenes of the suite).
+pub const CAP_QUANTILE: f64 = 0.99;
+
+/// Whether pixel (`x`, `y`) gathers as AIS off while racing: one pixel in four, on a
+/// regular lattice. (Where the field wins, every sample gathered as AIS off costs
+/// variance: with half the pixels racing, the sunlit room's relMSE rose 5%. A quarter of
+/// the pixels still tells the arms apart on every scene of the suite.)
+pub fn races_off(x: usize, y: usize) -> bool {
+    !x.is_multiple_of(2) && y.is_multiple_of(2)
+}
+
+/// The `q`-quantile of `values` (the value at rank ⌊q · (len − 1)⌋); infinity if empty.
+fn quantile(mut values: Vec<f64>, q: f64) -> f64 {
+    if values.is_empty() {
+        return f64::INFINITY;
+    }
+    let rank = ((values.len() - 1) as f64 * q) as usize;
+    *values.select_nth_unstable_by(rank, f64::total_cmp).1
+}
+
+/// Sums of one pixel's sample luminances.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelMoments {
+    /// Samples.
+    pub count: u32,
+    /// Their sum.
+    pub sum: f64,
+    /// The sum of their squares.
+    pub sum_squares: f64,
+}
+
+impl PixelMoments {
+    fn add(&mut self, value: f64) {
+        self.count += 1;
+        self.sum += value;
+        self.sum_squares += value * value;
+    }
+
+    fn merge(&mut self, other: PixelMoments) {
+        self.count += other.count;
+        self.sum += other.sum;
+        self.sum_squares += other.sum_squares;
+    }
+
+    fn mean(&self) -> Option<f64> {
+        (self.count > 0).then(|| self.sum / self.count as f64)
+    }
+
+    /// The unbiased sample variance (None below two samples).
+    fn variance(&self) -> Option<f64> {
+        (self.count >= 2).then(|| {
+            let n = self.count as f64;
+            ((self.sum_squares - self.sum * self.sum / n) / (n - 1.0)).max(0.0)
+        })
+    }
+}
+
+/// A tile's pixel moments in one race pass.
+#[derive(Clone, Debug)]
+pub struct TileMoments {
+    /// The tile's pixels.
+    pub rect: PixelRect,
+    /// Per pixel, row-major over `rect`.
+    pub pixels: Vec<PixelMoments>,
+    /// The pixel being sampled (index into `pixels`).
+    current: usize,
+}
+
+impl TileMoments {
+    /// Empty moments over `rect`.
+    pub fn new(rect: PixelRect) -> Self {
+        TileMoments {
+            rect,
+            pixels: vec![PixelMoments::default(); rect.area()],
+            current: 0,
+        }
+    }
+
+    /// Pixel (`x`, `y`), inside the rectangle, is sampled next.
+    pub fn begin_pixel(&mut self, x: usize, y: usize) {
+        self.current = (y - self.rect.y0) * self.rect.width() + (x - self.rect.x0);
+    }
+
+    /// Adds a sample of the current pixel.
+    pub fn sampled(&mut self, value: [f32; 3]) {
+        let value = luminance(Vec3::from(value)) as f64;
+        // A non-finite sample would poison the sums; the film reports it elsewhere.
+        if value.is_finite() {
+            self.pixels[self.current].add(value);
+        }
+    }
+}
+
+/// The race's evidence over the image, and its verdict.
+#[derive(Clone, Debug, Default)]
+pub struct Race {
+    width: usize,
+    height: usize,
+    pixels: Vec<PixelMoments>,
+}
+
+/// The per-arm weighted variances of a race (means over the arm's pixels, each capped at
+/// the [`CAP_QUANTILE`] of all).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RaceResult {
+    /// The field's arm.
+    pub field: f64,
+    /// AIS off's arm.
+    pub off: f64,
+}
+
+impl RaceResult {
+    /// Whether the field pays: its variance times [`RACE_MARGIN`] below AIS off's.
+    pub fn field_pays(&self) -> bool {
+        self.field * RACE_MARGIN < self.off
+    }
+}
+
+impl Race {
+    /// An empty race over a `width × height` image.
+    pub fn new(width: usize, height: usize) -> Self {
+        Race {
+            width,
+            height,
+            pixels: Vec::new(),
+        }
+    }
+
+    /// Adds a tile's moments (allocating the image's on first use).
+    pub fn merge(&mut self, tile: &TileMoments) {
+        if self.pixels.is_empty() {
+            self.pixels = vec![PixelMoments::default(); self.width * self.height];
+        }
+        for ((x, y), &moments) in tile.rect.pixels().zip(&tile.pixels) {
+            self.pixels[y * self.width + x].merge(moments);
+        }
+    }
+
+    /// Each arm's mean relMSE-weighted per-sample variance; `None` until both arms have
+    /// pixels with two samples or more.
+    pub fn result(&self) -> Option<RaceResult> {
+        let mut weighted = Vec::new(); // (races off, weighted variance) per pixel
+        for y in 0..self.height.min(self.pixels.len() / self.width.max(1)) {
+            for x in 0..self.width {
+                if let Some(variance) = self.pixels[y * self.width + x].variance() {
+                    let reference = self.neighbourhood_mean(x, y);
+                    weighted.push((races_off(x, y), variance / (reference * reference + 0.01)));
+                }
+            }
+        }
+        let cap = quantile(weighted.iter().map(|&(_, v)| v).collect(), CAP_QUANTILE);
+        // Where nearly every pixel is noiseless, capping would hide the rest.
+        let cap = if cap > 0.0 { cap } else { f64::INFINITY };
+        let mut sums = [[0.0f64; 2]; 2]; // [field, off] × [capped variance, pixels]
+        for (off, variance) in weighted {
+            let arm = &mut sums[usize::from(off)];
+            arm[0] += variance.min(cap);
+            arm[1] += 1.0;
+        }
+        let [field, off] = sums;
+        (field[1] > 0.0 && off[1] > 0.0).then(|| RaceResult {
+            field: field[0] / field[1],
+            off: off[0] / off[1],
+        })
+    }
+
+    /// The mean of the pixel means around (`x`, `y`), itself included (both arms).
+    fn neighbourhood_mean(&self, x: usize, y: usize) -> f64 {
+        let (mut sum, mut count) = (0.0, 0.0);
+        for ny in y.saturating_sub(1)..(y + 2).min(self.height) {
+            for nx in x.saturating_sub(1)..(x + 2).min(self.width) {
+                if let Some(mean) = self.pixels[ny * self.width + nx].mean() {
+                    sum += mean;
+                    count += 1.0;
+                }
+            }
+        }
+        sum / count
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A race over a 16 × 16 image whose pixels all hold `samples(x, y)`.
+    fn race_of(samples: impl Fn(usize, usize) -> Vec<f32>) -> Race {
+        let rect = PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: 16,
+            y1: 16,
+        };
+        let mut tile = TileMoments::new(rect);
+        for (x, y) in rect.pixels() {
+            tile.begin_pixel(x, y);
+            for value in samples(x, y) {
+                tile.sampled([value; 3]);
+            }
+        }
+        let mut race = Race::new(16, 16);
+        race.merge(&tile);
+        race
+    }
+
+    #[test]
+    fn the_quieter_arm_wins() {
+        // Both arms average 1; the off arm's samples spread by ±0.5, the field's by ±0.1.
+        let spread = |x, y| if races_off(x, y) { 0.5 } else { 0.1 };
+        let race = race_of(|x, y| vec![1.0 - spread(x, y), 1.0 + spread(x, y)]);
+        let result = race.result().unwrap();
+        // Variance of two samples ±s: 2s²; weighted by 1 / (1 + 0.01).
+        assert!((result.off - 0.5 / 1.01).abs() < 1e-6, "{result:?}");
+        assert!((result.field - 0.02 / 1.01).abs() < 1e-6, "{result:?}");
+        assert!(result.field_pays());
+        // Reversed, the field does not pay.
+        let race = race_of(|x, y| vec![1.0 - spread(y + 1, x), 1.0 + spread(y + 1, x)]);
+        assert!(!race.result().unwrap().field_pays());
+    }
+
+    #[test]
+    fn a_small_gain_does_not_pay_for_guiding() {
+        // The field's variance 5% below off's: less than guiding costs.
+        let spread = |x, y| if races_off(x, y) { 1.0 } else { 0.95f32.sqrt() };
+        let race = race_of(|x, y| vec![1.0 - spread(x, y), 1.0 + spread(x, y)]);
+        assert!(!race.result().unwrap().field_pays());
+    }
+
+    #[test]
+    fn a_few_fireflies_do_not_decide_the_race() {
+        // The field's pixels are quieter, but two of them hold a firefly: the plain mean of
+        // the field's arm would be many times AIS off's.
+        let firefly = |x, y| y == 3 && (x == 2 || x == 9);
+        let race = race_of(|x, y| match (races_off(x, y), firefly(x, y)) {
+            (true, _) => vec![0.5, 1.5],
+            (false, true) => vec![1.0, 1.0, 10_000.0],
+            (false, false) => vec![0.8, 1.2],
+        });
+        let result = race.result().unwrap();
+        assert!(result.field_pays(), "{result:?}");
+    }
+
+    #[test]
+    fn one_sample_per_pixel_gives_no_verdict() {
+        assert_eq!(race_of(|_, _| vec![1.0]).result(), None);
+    }
+}
