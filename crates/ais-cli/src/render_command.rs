@@ -380,9 +380,20 @@ fn print_gather_summary(
             rendered.output.stats.field_cost_ratio
         );
     }
+    if rendered.output.stats.field_stood_aside && rendered.output.stats.field_race.is_none() {
+        println!("field        stood aside after its first passes: it found almost nothing to guide or roll, and the rest gathered as AIS off");
+    }
     if let Some(race) = rendered.output.stats.field_race {
+        let timed = race
+            .seconds_per_sample
+            .map_or(String::new(), |[field, off]| {
+                format!(
+                    "; time per sample with the field / AIS off {:.3}",
+                    field / off
+                )
+            });
         println!(
-            "field race   pixel variance with the field {:.3e}, AIS off {:.3e} (ratio {:.3}): {}",
+            "field race   pixel variance with the field {:.3e}, AIS off {:.3e} (ratio {:.3}{timed}): {}",
             race.field,
             race.off,
             race.field / race.off,

@@ -241,6 +241,25 @@ fn the_race_of_the_field_against_ais_off_is_reproducible() {
     assert!(race.field > 0.0 && race.off > 0.0, "{race:?}");
 }
 
+#[test]
+fn where_the_field_rolls_the_race_is_timed_unless_the_cost_ratio_is_pinned() {
+    let world = interior(48, 27);
+    let rolling = GatherSettings {
+        rays: 128,
+        ..GatherSettings::default()
+    };
+    let timed = render_with(&world, Integrator::Gather(rolling), 8);
+    let race = timed.stats.field_race.expect("the rolling field raced");
+    let [field, off] = race.seconds_per_sample.expect("a timed race");
+    assert!(field > 0.0 && off > 0.0);
+    let pinned = GatherSettings {
+        cost_ratio: Some(1.0),
+        ..rolling
+    };
+    let reproducible = render_with(&world, Integrator::Gather(pinned), 8);
+    assert_eq!(reproducible.stats.field_race, None);
+}
+
 /// A learning whose race passes saw every pixel's two samples at 1 ± `spread(x, y)`.
 fn raced(world: &World, spread: impl Fn(usize, usize) -> f32) -> gather::GatherLearning {
     use ais_render::integrators::gather::race::TileMoments;
@@ -249,7 +268,7 @@ fn raced(world: &World, spread: impl Fn(usize, usize) -> f32) -> gather::GatherL
     let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
     let rect = PixelRect::whole(width, height);
     for pass in 0..3 {
-        let mut moments = TileMoments::new(rect);
+        let mut moments = TileMoments::new(rect, false);
         for (x, y) in rect.pixels() {
             moments.begin_pixel(x, y);
             moments.sampled([1.0 - spread(x, y); 3]);

@@ -201,15 +201,24 @@ impl GatherLearning {
     }
 
     /// Whether the field has no use in the rest of the render, which then gathers as AIS
-    /// off: it lost its race, or, where it does not roll, its last pass guided fewer than
-    /// [`LEAST_GUIDED_SHARE`] of the gathers it could guide.
+    /// off: it lost its race; or, where it does not roll, its last pass guided fewer than
+    /// [`LEAST_GUIDED_SHARE`] of the gathers it could guide; or, where it rolls, roulette
+    /// pays for fewer than [`LEAST_ROLLING_SHARE`] of the rays before the race could end
+    /// (measured at 128 candidates: a field kept for its guiding alone then lost 3–10%
+    /// under open skies, behind a roof edge and among sphere lights).
     pub fn stands_aside(&self) -> bool {
         let lost_race = self.race_result.is_some_and(|race| !race.field_pays());
-        let guides_little = !self.rolls
-            && self
-                .guided_share
-                .is_some_and(|share| share < LEAST_GUIDED_SHARE);
-        lost_race || guides_little
+        let little_use = if self.rolls {
+            self.race_result.is_none()
+                && self
+                    .field
+                    .rolling_share()
+                    .is_some_and(|share| share < LEAST_ROLLING_SHARE)
+        } else {
+            self.guided_share
+                .is_some_and(|share| share < LEAST_GUIDED_SHARE)
+        };
+        lost_race || little_use
     }
 
     /// The cost ratio the next pass uses: the settings' `cost_ratio` if given, else the one
@@ -261,6 +270,7 @@ impl Learning for GatherLearning {
         if self.stands_aside() {
             return false;
         }
+        // After the race, the field's roulette alone decides.
         !self.rolls
             || self
                 .field
@@ -270,7 +280,8 @@ impl Learning for GatherLearning {
 }
 
 /// Whether the tile's next field gather is one of the timed ones (one in
-/// [`TIMED_ONE_IN`], while learning with a measured cost ratio for roulette).
+/// [`TIMED_ONE_IN`], while learning with a measured cost ratio for roulette; not a pixel
+/// racing as AIS off, which does not roll).
 pub(super) fn times_next_gather<P: BatchProbe>(
     state: &GatherTile<P>,
     settings: &GatherSettings,
@@ -278,6 +289,7 @@ pub(super) fn times_next_gather<P: BatchProbe>(
     state.observations.is_some()
         && settings.cost_ratio.is_none()
         && field_rolls(settings)
+        && !(state.race.is_some() && state.racing_off)
         && (state.gathers + 1).is_multiple_of(TIMED_ONE_IN)
 }
 
@@ -374,7 +386,7 @@ pub(super) fn field_gather<P: BatchProbe>(
     let rolls = field_rolls(settings);
     let rolling = known
         .map(|(_, cell)| cell)
-        .filter(|cell| rolls && cell.worth_rolling(cost_ratio));
+        .filter(|cell| rolls && !racing_off && cell.worth_rolling(cost_ratio));
     let mut at: GatherPoint<'_> = site.at;
     let guides = field_guides.as_mut().filter(|_| !racing_off);
     if let (Some(guides), Some((index, cell))) = (guides, known) {

@@ -68,6 +68,8 @@ pub struct GatherStats {
     pub field_cost_ratio: f32,
     /// The race of the field against AIS off, where one was run (see [`race`]).
     pub field_race: Option<RaceResult>,
+    /// Whether the field stood aside for the last pass (it gathered as AIS off).
+    pub field_stood_aside: bool,
 }
 
 impl TileStats for GatherStats {
@@ -81,6 +83,7 @@ impl TileStats for GatherStats {
         self.field_guided += other.field_guided;
         self.field_cost_ratio = self.field_cost_ratio.max(other.field_cost_ratio);
         self.field_race = self.field_race.or(other.field_race);
+        self.field_stood_aside |= other.field_stood_aside;
     }
 }
 
@@ -142,10 +145,13 @@ impl<P: BatchProbe> GatherTile<P> {
         probe: P,
     ) -> Self {
         let field = settings.map == MapSource::Field;
+        // Where the field rolls, the race is timed: not with a pinned cost ratio, whose
+        // images are reproducible.
+        let rolls = field::field_rolls(settings);
         let races = field
             && tile.learns
             && field::field_has_use(world, settings)
-            && !field::field_rolls(settings)
+            && !(rolls && settings.cost_ratio.is_some())
             && race::RACE_PASSES.contains(&learning.passes_ended());
         let mut state = GatherTile {
             batch: None,
@@ -172,7 +178,7 @@ impl<P: BatchProbe> GatherTile<P> {
             cost_ratio: learning.cost_ratio(),
             cost: CostSample::default(),
             gathers: 0,
-            race: races.then(|| TileMoments::new(tile.rect)),
+            race: races.then(|| TileMoments::new(tile.rect, rolls)),
             racing_off: false,
             raced_off: 0,
             stands_aside: learning.stands_aside(),
@@ -229,7 +235,10 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
             cost: std::mem::take(&mut self.cost),
             // Gathers racing as AIS off could not be guided.
             guided: [self.field_guided, gathers - self.raced_off],
-            moments: self.race.take(),
+            moments: self.race.take().map(|mut moments| {
+                moments.end_pixel();
+                moments
+            }),
         })
     }
 
@@ -259,6 +268,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
             field_guided: self.field_guided,
             field_cost_ratio: self.cost_ratio,
             field_race: self.race_result,
+            field_stood_aside: self.stands_aside,
         }
     }
 }

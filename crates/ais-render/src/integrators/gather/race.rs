@@ -13,15 +13,22 @@
 //! arm's image is less noisy. Neighbouring pixels see the same scene, so the arms differ only in how
 //! they gather.
 //!
-//! The verdict after the race passes keeps the field only if its arm's variance, times
-//! [`RACE_MARGIN`], is below AIS off's; else the rest of the render gathers as AIS off,
-//! with no field work at all. It reads sample values only, merged in a fixed order, so the
-//! image stays the same at any thread count. Choosing how later passes gather from what
-//! earlier passes saw keeps every pass unbiased.
+//! Where the field only guides (below 64 candidates), the verdict after the race passes
+//! keeps the field only if its arm's variance, times [`RACE_MARGIN`], is below AIS off's.
+//! It reads sample values only, merged in a fixed order, so the image stays the same at
+//! any thread count. Where the field's roulette runs, its gain is in time, which variance
+//! does not show: there each arm's pixels are also timed, and the field is kept only if
+//! its variance times its time per sample is below AIS off's (such renders already depend
+//! on timings, through the measured cost ratio; with the cost ratio pinned, they do not
+//! race). The arms' pixels are interleaved in space and in time, so the machine's drifting
+//! speed falls on both alike. Where the field loses, the rest of the render gathers as AIS
+//! off, with no field work at all. Choosing how later passes gather from what earlier
+//! passes saw keeps every pass unbiased.
 
 use crate::render::PixelRect;
 use crate::texture::luminance;
 use glam::Vec3;
+use std::time::Instant;
 
 /// The passes (by index) whose pixels race: the first two that read a field (1 and 2
 /// samples per pixel), so a pixel has 3 samples for its variance.
@@ -69,6 +76,8 @@ pub struct PixelMoments {
     pub sum: f64,
     /// The sum of their squares.
     pub sum_squares: f64,
+    /// Seconds spent on them (0 where the race is not timed).
+    pub seconds: f64,
 }
 
 impl PixelMoments {
@@ -82,6 +91,7 @@ impl PixelMoments {
         self.count += other.count;
         self.sum += other.sum;
         self.sum_squares += other.sum_squares;
+        self.seconds += other.seconds;
     }
 
     fn mean(&self) -> Option<f64> {
@@ -106,21 +116,36 @@ pub struct TileMoments {
     pub pixels: Vec<PixelMoments>,
     /// The pixel being sampled (index into `pixels`).
     current: usize,
+    /// When the current pixel began, where pixels are timed.
+    started: Option<Instant>,
+    /// Whether pixels are timed.
+    timed: bool,
 }
 
 impl TileMoments {
-    /// Empty moments over `rect`.
-    pub fn new(rect: PixelRect) -> Self {
+    /// Empty moments over `rect`; each pixel's time is measured if `timed`.
+    pub fn new(rect: PixelRect, timed: bool) -> Self {
         TileMoments {
             rect,
             pixels: vec![PixelMoments::default(); rect.area()],
             current: 0,
+            started: None,
+            timed,
         }
     }
 
     /// Pixel (`x`, `y`), inside the rectangle, is sampled next.
     pub fn begin_pixel(&mut self, x: usize, y: usize) {
+        self.end_pixel();
         self.current = (y - self.rect.y0) * self.rect.width() + (x - self.rect.x0);
+        self.started = self.timed.then(Instant::now);
+    }
+
+    /// Adds the time of the current pixel, if timed (the tile's last pixel ends here).
+    pub fn end_pixel(&mut self) {
+        if let Some(started) = self.started.take() {
+            self.pixels[self.current].seconds += started.elapsed().as_secs_f64();
+        }
     }
 
     /// Adds a sample of the current pixel.
@@ -142,19 +167,25 @@ pub struct Race {
 }
 
 /// The per-arm weighted variances of a race (means over the arm's pixels, each capped at
-/// the [`CAP_QUANTILE`] of all).
+/// the [`CAP_QUANTILE`] of all), and their times.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RaceResult {
     /// The field's arm.
     pub field: f64,
     /// AIS off's arm.
     pub off: f64,
+    /// Seconds per sample of the field's arm and of AIS off's, where the race was timed.
+    pub seconds_per_sample: Option<[f64; 2]>,
 }
 
 impl RaceResult {
-    /// Whether the field pays: its variance times [`RACE_MARGIN`] below AIS off's.
+    /// Whether the field pays: its variance times its time per sample below AIS off's
+    /// where timed; else its variance times [`RACE_MARGIN`] below AIS off's.
     pub fn field_pays(&self) -> bool {
-        self.field * RACE_MARGIN < self.off
+        match self.seconds_per_sample {
+            Some([field, off]) => self.field * field < self.off * off,
+            None => self.field * RACE_MARGIN < self.off,
+        }
     }
 }
 
@@ -203,7 +234,21 @@ impl Race {
         (field[1] > 0.0 && off[1] > 0.0).then(|| RaceResult {
             field: field[0] / field[1],
             off: off[0] / off[1],
+            seconds_per_sample: self.seconds_per_sample(),
         })
+    }
+
+    /// Each arm's seconds per sample, if its pixels were timed.
+    fn seconds_per_sample(&self) -> Option<[f64; 2]> {
+        let mut sums = [[0.0f64; 2]; 2]; // [field, off] × [seconds, samples]
+        for (index, pixel) in self.pixels.iter().enumerate() {
+            let off = races_off(index % self.width, index / self.width);
+            let arm = &mut sums[usize::from(off)];
+            arm[0] += pixel.seconds;
+            arm[1] += pixel.count as f64;
+        }
+        let [field, off] = sums;
+        (field[0] > 0.0 && off[0] > 0.0).then(|| [field[0] / field[1], off[0] / off[1]])
     }
 
     /// The mean of the pixel means around (`x`, `y`), itself included (both arms).
@@ -233,7 +278,7 @@ mod tests {
             x1: 16,
             y1: 16,
         };
-        let mut tile = TileMoments::new(rect);
+        let mut tile = TileMoments::new(rect, false);
         for (x, y) in rect.pixels() {
             tile.begin_pixel(x, y);
             for value in samples(x, y) {
@@ -280,6 +325,24 @@ mod tests {
         });
         let result = race.result().unwrap();
         assert!(result.field_pays(), "{result:?}");
+    }
+
+    #[test]
+    fn a_timed_race_weighs_variance_by_time() {
+        let variance_and_time = |field: f64, off: f64, seconds_per_sample: Option<[f64; 2]>| {
+            RaceResult {
+                field,
+                off,
+                seconds_per_sample,
+            }
+            .field_pays()
+        };
+        // Half the variance at 1.5 times the time pays; at 2.5 times it does not.
+        assert!(variance_and_time(0.5, 1.0, Some([1.5, 1.0])));
+        assert!(!variance_and_time(0.5, 1.0, Some([2.5, 1.0])));
+        // Roulette: 20% more variance at 30% less time pays, untimed it would not.
+        assert!(variance_and_time(1.2, 1.0, Some([0.7, 1.0])));
+        assert!(!variance_and_time(1.2, 1.0, None));
     }
 
     #[test]
