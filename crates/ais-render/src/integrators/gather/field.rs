@@ -289,7 +289,7 @@ pub(super) fn times_next_gather<P: BatchProbe>(
     state.observations.is_some()
         && settings.cost_ratio.is_none()
         && field_rolls(settings)
-        && !(state.race.is_some() && state.racing_off)
+        && !state.racing_off
         && (state.gathers + 1).is_multiple_of(TIMED_ONE_IN)
 }
 
@@ -371,13 +371,12 @@ pub(super) fn field_gather<P: BatchProbe>(
         cost,
         gathers,
         probe,
-        race,
         racing_off,
         raced_off,
         ..
     } = state;
     // A pixel racing as AIS off records its rays but is not guided (see `race`).
-    let racing_off = race.is_some() && *racing_off;
+    let racing_off = *racing_off;
     *raced_off += u64::from(racing_off);
     let cost_ratio = *cost_ratio;
     let known = find_cell(field, last_cell, site.key);

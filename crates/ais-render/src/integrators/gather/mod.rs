@@ -121,7 +121,7 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) gathers: u64,
     /// The pixel moments of a race pass (see [`race`]).
     pub(super) race: Option<TileMoments>,
-    /// Whether the current pixel gathers as AIS off in the race.
+    /// Whether the current pixel gathers as AIS off in a race pass.
     pub(super) racing_off: bool,
     /// Gathers that raced as AIS off in this pass.
     pub(super) raced_off: u64,
@@ -243,10 +243,13 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
     }
 
     fn begin_pixel(&mut self, x: usize, y: usize) {
-        if let Some(race) = self.race.as_mut() {
-            race.begin_pixel(x, y);
-            self.racing_off = race::races_off(x, y);
-        }
+        self.racing_off = match self.race.as_mut() {
+            Some(race) => {
+                race.begin_pixel(x, y);
+                race::races_off(x, y)
+            }
+            None => false,
+        };
     }
 
     fn sampled(&mut self, value: [f32; 3]) {

@@ -6,12 +6,12 @@
 //! lights seen directly, foliage at every scale) the guided gathers' extra cost buys
 //! nothing. So in the race passes ([`RACE_PASSES`]) one pixel in four ([`races_off`])
 //! gathers as AIS off and the others with the field; both arms record their rays for the
-//! field alike. Each pixel's samples give an unbiased estimate of its
-//! per-sample variance; weighted as relMSE weighs them (1 / (r² + 0.01), with r the mean
-//! of the 3 × 3 pixels around, both arms), capped at the 99th percentile of both arms
-//! ([`CAP_QUANTILE`]: a few fireflies must not decide) and averaged per arm, they say which
-//! arm's image is less noisy. Neighbouring pixels see the same scene, so the arms differ only in how
-//! they gather.
+//! field alike. Each pixel's samples give an unbiased estimate of its per-sample variance;
+//! weighted as relMSE weighs them (1 / (r² + 0.01), with r the mean of the 3 × 3 pixels
+//! around, both arms), capped at the 99th percentile of both arms ([`CAP_QUANTILE`]: a few
+//! fireflies must not decide) and averaged per arm, they say which arm's image is less
+//! noisy. Neighbouring pixels see the same scene, so the arms differ only in how they
+//! gather.
 //!
 //! Where the field only guides (below 64 candidates), the verdict after the race passes
 //! keeps the field only if its arm's variance, times [`RACE_MARGIN`], is below AIS off's.
