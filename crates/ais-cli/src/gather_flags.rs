@@ -71,6 +71,11 @@ pub struct GatherFlags {
     /// map field: pseudo-observations per cell (free) and texel (at its cell's visibility).
     #[arg(long)]
     field_prior: Option<String>,
+    /// map field: "false" keeps the field for the whole render; "true" (the default) races
+    /// it against AIS off in the second and third passes and gathers the rest as AIS off
+    /// where it loses.
+    #[arg(long)]
+    field_race: Option<String>,
     /// Mitsuba's hide_emitters: "true" hides the emitters the camera sees directly.
     #[arg(long)]
     hide_emitters: Option<String>,
@@ -97,6 +102,7 @@ impl GatherFlags {
             "field_res" => &self.field_res,
             "field_cell" => &self.field_cell,
             "field_prior" => &self.field_prior,
+            "field_race" => &self.field_race,
             "hide_emitters" => &self.hide_emitters,
             _ => &None,
         };

@@ -168,6 +168,8 @@ pub struct GatherLearning {
     race: Race,
     /// The race's result, once its passes ended.
     race_result: Option<RaceResult>,
+    /// Whether the field may stand aside (`field_race`).
+    may_stand_aside: bool,
 }
 
 impl GatherLearning {
@@ -187,6 +189,7 @@ impl GatherLearning {
             passes: 0,
             race: Race::new(world.resolution.0 as usize, world.resolution.1 as usize),
             race_result: None,
+            may_stand_aside: settings.field_race,
         }
     }
 
@@ -201,12 +204,15 @@ impl GatherLearning {
     }
 
     /// Whether the field has no use in the rest of the render, which then gathers as AIS
-    /// off: it lost its race; or, where it does not roll, its last pass guided fewer than
+    /// off (never with `field_race` false): it lost its race; or, where it does not roll, its last pass guided fewer than
     /// [`LEAST_GUIDED_SHARE`] of the gathers it could guide; or, where it rolls, roulette
     /// pays for fewer than [`LEAST_ROLLING_SHARE`] of the rays before the race could end
     /// (measured at 128 candidates: a field kept for its guiding alone then lost 3–10%
     /// under open skies, behind a roof edge and among sphere lights).
     pub fn stands_aside(&self) -> bool {
+        if !self.may_stand_aside {
+            return false;
+        }
         let lost_race = self.race_result.is_some_and(|race| !race.field_pays());
         let little_use = if self.rolls {
             self.race_result.is_none()
@@ -270,12 +276,16 @@ impl Learning for GatherLearning {
         if self.stands_aside() {
             return false;
         }
-        // After the race, the field's roulette alone decides.
-        !self.rolls
-            || self
-                .field
+        // After the race (or without one), as much use as it takes to stand aside stops
+        // the learning but keeps the field.
+        if self.rolls {
+            self.field
                 .rolling_share()
                 .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
+        } else {
+            self.guided_share
+                .is_none_or(|share| share >= LEAST_GUIDED_SHARE)
+        }
     }
 }
 

@@ -149,6 +149,7 @@ impl<P: BatchProbe> GatherTile<P> {
         // images are reproducible.
         let rolls = field::field_rolls(settings);
         let races = field
+            && settings.field_race
             && tile.learns
             && field::field_has_use(world, settings)
             && !(rolls && settings.cost_ratio.is_some())

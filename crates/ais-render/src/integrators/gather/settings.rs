@@ -19,6 +19,7 @@
 //! | `field_res` | integer | 8 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
 //! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
+//! | `field_race` | boolean | true | `map = field`: race the field against AIS off in the second and third passes and gather the rest as AIS off where it loses, or where it finds almost nothing to guide or roll; false keeps the field for the whole render (to study it) |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
 //! | `cost_ratio` | float or `measured` | `measured` | `map = field` with roulette (64 or more candidates): ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass but the last unless given (give it to make such an image reproducible bit for bit; with fewer candidates nothing is timed) |
 //!
@@ -35,7 +36,7 @@ use crate::scene::{Plugin, Property};
 use ais::{BatchConfig, MapConfig, Mode, Stopping};
 
 /// The parameter names, in the order they apply (a preset before the settings it bundles).
-pub const PARAMETERS: [&str; 18] = [
+pub const PARAMETERS: [&str; 19] = [
     "strategy",
     "rays",
     "budget",
@@ -53,6 +54,7 @@ pub const PARAMETERS: [&str; 18] = [
     "field_res",
     "field_cell",
     "field_prior",
+    "field_race",
     "hide_emitters",
 ];
 
@@ -264,6 +266,9 @@ pub struct GatherSettings {
     /// `map = field`: pseudo-observations added to every cell (free) and texel (at its
     /// cell's visibility).
     pub field_prior: f32,
+    /// `map = field`: whether the field races AIS off and may stand aside (see
+    /// [`super::race`]); false keeps it for the whole render.
+    pub field_race: bool,
     /// Mitsuba's `hide_emitters`: camera rays add no emission of the emitters they hit
     /// directly, and the environment seen directly is black.
     pub hide_emitters: bool,
@@ -295,6 +300,7 @@ impl Default for GatherSettings {
             field_res: ais::field::DEFAULT_SIDE,
             field_cell: 4.0,
             field_prior: ais::field::PRIOR_FREE,
+            field_race: true,
             hide_emitters: false,
         }
     }
@@ -392,6 +398,14 @@ fn number<T: std::str::FromStr>(value: &str, what: &str) -> Result<T, String> {
         .map_err(|_| format!("{what} \"{value}\" is not a number of the right kind"))
 }
 
+fn boolean(value: &str, what: &str) -> Result<bool, String> {
+    match value.trim() {
+        "true" => Ok(true),
+        "false" => Ok(false),
+        _ => Err(format!("{what} \"{value}\" is not true or false")),
+    }
+}
+
 impl GatherSettings {
     /// The defaults with a preset's map settings.
     pub fn preset(preset: Preset) -> Self {
@@ -452,13 +466,8 @@ impl GatherSettings {
             "tol" => self.tol = number(value, "tol")?,
             "map_res" => self.map_height = number(value, "map_res")?,
             "guide_fraction" => self.guide_fraction = Some(number(value, "guide_fraction")?),
-            "hide_emitters" => {
-                self.hide_emitters = match value {
-                    "true" => true,
-                    "false" => false,
-                    _ => return Err(format!("hide_emitters \"{value}\" is not true or false")),
-                }
-            }
+            "hide_emitters" => self.hide_emitters = boolean(value, "hide_emitters")?,
+            "field_race" => self.field_race = boolean(value, "field_race")?,
             "field_res" => self.field_res = number(value, "field_res")?,
             "field_cell" => self.field_cell = number(value, "field_cell")?,
             "field_prior" => self.field_prior = number(value, "field_prior")?,
