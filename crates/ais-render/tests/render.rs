@@ -242,22 +242,20 @@ fn the_race_of_the_field_against_ais_off_is_reproducible() {
 }
 
 #[test]
-fn where_the_field_rolls_the_race_is_timed_unless_the_cost_ratio_is_pinned() {
+fn with_a_pinned_cost_ratio_the_rolling_field_does_not_race() {
+    // A rolling field's race is timed (race.rs's tests); with the cost ratio pinned the
+    // image must not depend on timings, so there is no race, and the field rolls.
     let world = interior(48, 27);
-    let rolling = GatherSettings {
+    let pinned = GatherSettings {
         rays: 128,
+        cost_ratio: Some(0.05),
         ..GatherSettings::default()
     };
-    let timed = render_with(&world, Integrator::Gather(rolling), 8);
-    let race = timed.stats.field_race.expect("the rolling field raced");
-    let [field, off] = race.seconds_per_sample.expect("a timed race");
-    assert!(field > 0.0 && off > 0.0);
-    let pinned = GatherSettings {
-        cost_ratio: Some(1.0),
-        ..rolling
-    };
-    let reproducible = render_with(&world, Integrator::Gather(pinned), 8);
-    assert_eq!(reproducible.stats.field_race, None);
+    let one = on_threads_at(&world, 1, Integrator::Gather(pinned), 8);
+    let two = on_threads_at(&world, 2, Integrator::Gather(pinned), 8);
+    assert_eq!(one.stats.field_race, None);
+    assert!(one.stats.ais.rejected_roulette > 0, "the field rolled");
+    assert_eq!(bits(&one.image), bits(&two.image));
 }
 
 /// A learning whose race passes saw every pixel's two samples at 1 ± `spread(x, y)`.

@@ -328,6 +328,33 @@ mod tests {
     }
 
     #[test]
+    fn a_timed_tile_measures_its_pixels() {
+        let rect = PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: 2,
+            y1: 2,
+        };
+        let mut tile = TileMoments::new(rect, true);
+        for (x, y) in rect.pixels() {
+            tile.begin_pixel(x, y);
+            tile.sampled([1.0; 3]);
+            tile.sampled([3.0; 3]);
+            std::thread::sleep(std::time::Duration::from_millis(1));
+        }
+        tile.end_pixel();
+        assert!(tile.pixels.iter().all(|p| p.seconds >= 1e-3), "{tile:?}");
+        let mut race = Race::new(2, 2);
+        race.merge(&tile);
+        let [field, off] = race.result().unwrap().seconds_per_sample.unwrap();
+        assert!(field >= 5e-4 && off >= 5e-4, "{field} {off}");
+        // Untimed, a race has no times.
+        let mut untimed = Race::new(2, 2);
+        untimed.merge(&TileMoments::new(rect, false));
+        assert_eq!(untimed.seconds_per_sample(), None);
+    }
+
+    #[test]
     fn a_timed_race_weighs_variance_by_time() {
         let variance_and_time = |field: f64, off: f64, seconds_per_sample: Option<[f64; 2]>| {
             RaceResult {
