@@ -272,12 +272,7 @@ mod tests {
 
     /// A race over a 16 × 16 image whose pixels all hold `samples(x, y)`.
     fn race_of(samples: impl Fn(usize, usize) -> Vec<f32>) -> Race {
-        let rect = PixelRect {
-            x0: 0,
-            y0: 0,
-            x1: 16,
-            y1: 16,
-        };
+        let rect = PixelRect::whole(16, 16);
         let mut tile = TileMoments::new(rect, false);
         for (x, y) in rect.pixels() {
             tile.begin_pixel(x, y);
@@ -329,12 +324,7 @@ mod tests {
 
     #[test]
     fn a_timed_tile_measures_its_pixels() {
-        let rect = PixelRect {
-            x0: 0,
-            y0: 0,
-            x1: 2,
-            y1: 2,
-        };
+        let rect = PixelRect::whole(2, 2);
         let mut tile = TileMoments::new(rect, true);
         for (x, y) in rect.pixels() {
             tile.begin_pixel(x, y);
