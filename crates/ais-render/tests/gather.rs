@@ -4,6 +4,7 @@
 
 mod common;
 
+use ais_render::integrators::gather::field::field_rolls;
 use ais_render::integrators::gather::{
     Acceptance, GatherSettings, MapUse, Preset, RayBudget, Sharing, Strategy,
 };
@@ -415,30 +416,50 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
         ("sphere_lights.xml", Strategy::Light, MapUse::Both, false),
     ];
     for (scene, strategy, map_use, field_race) in cases {
-        let world = small_shipped_scene(scene);
-        let off = settings(Strategy::Mis, Preset::Off, 64);
-        let reference = pixel_statistics(&world, off, 32, 16);
+        // At 12 × 8 pixels the default cells (16 footprints) would span the image, and
+        // their 256 texels see too few rays for roulette to skip any: smaller cells and
+        // maps, so that every use of the field is exercised.
         let gather = GatherSettings {
             budget: RayBudget::Candidates,
             map_use,
             field_race,
+            field_res: 8,
+            field_cell: 4.0,
             ..settings(strategy, Preset::Auto, 64)
         };
-        let settings = RenderSettings {
-            samples_per_pixel: 8,
-            seed: 1,
-            progress: false,
-            crop: None,
-        };
-        let output = render(&world, &Integrator::Gather(gather), &settings);
-        let guided = output.stats.field_guided > 0;
-        assert_eq!(guided, map_use.guides(), "{scene} {map_use:?}: guided");
-        let rolled = output.stats.ais.rejected_roulette > 0;
-        assert_eq!(rolled, map_use.rolls(), "{scene} {map_use:?}: rolled");
-        let statistics = pixel_statistics(&world, gather, 8, 48);
-        if let Err(message) = agreement(&statistics, &reference) {
-            panic!("{scene} {strategy:?} {map_use:?}: {message}");
-        }
+        assert_field_agrees_with_ais_off(scene, gather);
+    }
+    // The default field (pooled 16 × 16 maps) guiding a room at 16 candidates, as `auto`
+    // renders it by default.
+    let gather = GatherSettings {
+        budget: RayBudget::Candidates,
+        ..settings(Strategy::Mis, Preset::Auto, 16)
+    };
+    assert_field_agrees_with_ais_off("interior.xml", gather);
+}
+
+/// Renders the shipped `scene` at 12 × 8 pixels with `gather` (a field preset), checks
+/// that the field guided and rolled as its `map_use` says, and that every pixel agrees
+/// with AIS off.
+fn assert_field_agrees_with_ais_off(scene: &str, gather: GatherSettings) {
+    let world = small_shipped_scene(scene);
+    let off = settings(Strategy::Mis, Preset::Off, 64);
+    let reference = pixel_statistics(&world, off, 32, 16);
+    let settings = RenderSettings {
+        samples_per_pixel: 8,
+        seed: 1,
+        progress: false,
+        crop: None,
+    };
+    let output = render(&world, &Integrator::Gather(gather), &settings);
+    let map_use = gather.map_use;
+    let guided = output.stats.field_guided > 0;
+    assert_eq!(guided, map_use.guides(), "{scene} {map_use:?}: guided");
+    let rolled = output.stats.ais.rejected_roulette > 0;
+    assert_eq!(rolled, field_rolls(&gather), "{scene} {map_use:?}: rolled");
+    let statistics = pixel_statistics(&world, gather, 8, 48);
+    if let Err(message) = agreement(&statistics, &reference) {
+        panic!("{scene} {:?} {map_use:?}: {message}", gather.strategy);
     }
 }
 

@@ -22,6 +22,7 @@
 //! ([`VisibilityField::with_sources`], [`FieldCell::source_visibility`]).
 
 pub mod octahedral;
+pub mod pooling;
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -149,6 +150,8 @@ pub struct VisibilityField {
     counts: Vec<TexelCounts>,
     /// Per cell, the sum of its texels' counts.
     totals: Vec<TexelCounts>,
+    /// Per cell, its texels' visibilities pooled with their blocks' ([`pooling`]).
+    pooled: Vec<f32>,
     /// Per cell, the lowest visibility of its texels.
     darkest: Vec<f32>,
     /// The cost ratio of the last [`VisibilityField::plan`] (None after a merge).
@@ -157,8 +160,11 @@ pub struct VisibilityField {
     expected_rejection: Vec<f32>,
 }
 
-/// Texels per side of a cell's map by default: 64 texels of 0.2 sr each.
-pub const DEFAULT_SIDE: u32 = 8;
+/// Texels per side of a cell's map by default: 256 texels of 0.05 sr each (a window a few
+/// metres away fills a few of them). Finer maps learn more slowly; pooling their texels
+/// with their blocks ([`pooling`]) is what makes this size pay (measured on the rooms of the
+/// repository's scene suite: BENCHMARKS.md, section 5.6).
+pub const DEFAULT_SIDE: u32 = 16;
 
 impl Default for VisibilityField {
     fn default() -> Self {
@@ -176,6 +182,7 @@ impl VisibilityField {
             cells: KeyMap::default(),
             counts: Vec::new(),
             totals: Vec::new(),
+            pooled: Vec::new(),
             darkest: Vec::new(),
             planned: None,
             expected_rejection: Vec::new(),
@@ -229,7 +236,9 @@ impl VisibilityField {
         std::mem::size_of::<Self>()
             + self.cells.capacity() * (std::mem::size_of::<(CellKey, u32)>() + 1)
             + (self.counts.capacity() + self.totals.capacity()) * std::mem::size_of::<TexelCounts>()
-            + (self.darkest.capacity() + self.expected_rejection.capacity())
+            + (self.pooled.capacity()
+                + self.darkest.capacity()
+                + self.expected_rejection.capacity())
                 * std::mem::size_of::<f32>()
     }
 
@@ -295,6 +304,7 @@ impl VisibilityField {
         let index = first / self.stride();
         FieldCell {
             counts: &self.counts[first..first + texels],
+            pooled: &self.pooled[index * texels..(index + 1) * texels],
             sources: &self.counts[first + texels..first + self.stride()],
             total: self.totals[index],
             darkest: self.darkest[index],
@@ -324,6 +334,7 @@ impl VisibilityField {
             if first == next as usize {
                 self.counts.resize(first + stride, TexelCounts::default());
                 self.totals.push(TexelCounts::default());
+                self.pooled.resize(self.pooled.len() + texels, 1.0);
                 self.darkest.push(1.0);
             }
             let index = first / stride;
@@ -333,11 +344,15 @@ impl VisibilityField {
                     self.totals[index].add(count);
                 }
             }
+            let counts = &self.counts[first..first + texels];
             let cell = visibility(self.totals[index], self.prior);
-            self.darkest[index] = self.counts[first..first + texels]
+            self.darkest[index] = counts
                 .iter()
                 .map(|&c| texel_visibility(c, cell, self.prior))
                 .fold(1.0, f32::min);
+            self.pooled[index * texels..(index + 1) * texels].copy_from_slice(
+                &pooling::pooled_visibilities(counts, self.side, cell, self.prior),
+            );
         }
     }
 }
@@ -436,6 +451,8 @@ pub fn acceptance(texel: f32, cell: f32, cost_ratio: f32) -> f32 {
 #[derive(Clone, Copy, Debug)]
 pub struct FieldCell<'a> {
     counts: &'a [TexelCounts],
+    /// Its texels' visibilities, pooled with their blocks' ([`pooling`]).
+    pooled: &'a [f32],
     /// The counts of the rays aimed at each source.
     sources: &'a [TexelCounts],
     total: TexelCounts,
@@ -460,10 +477,15 @@ impl FieldCell<'_> {
     }
 
     /// The visibility of texel `index` (row-major, as [`octahedral::texel_of`] numbers
-    /// them) with the field's prior, or `None` where no ray of the cell went.
-    pub fn texel_visibility_at(&self, index: usize) -> Option<f32> {
-        let counts = *self.counts.get(index)?;
-        (counts.traced > 0).then(|| texel_visibility(counts, self.visibility(), self.prior))
+    /// them) pooled with its blocks' ([`pooling`]), or `None` where no ray of the cell went
+    /// into its 2 × 2 block. Pooling lends a texel seen a few times its neighbours'
+    /// evidence, and the same rays count at every level: sharp where rays are few, and
+    /// overconfident. A proposal that keeps a defensive share can use it (a wrong estimate
+    /// costs a bounded factor in variance); roulette, whose mistakes cost 1 / a, reads
+    /// each texel's own evidence ([`FieldCell::acceptance`]).
+    pub fn pooled_visibility_at(&self, index: usize) -> Option<f32> {
+        let estimate = *self.pooled.get(index)?;
+        pooling::block_seen(self.counts, self.side, index).then_some(estimate)
     }
 
     /// The visibility of the rays aimed at `source`, with the field's prior (centred on the
@@ -670,6 +692,41 @@ mod tests {
             .cell(&CellKey::new([5.0, 0.0, 0.0], [0.0, 1.0, 0.0], -3))
             .is_none());
         assert_eq!(field.cell_count(), 2);
+    }
+
+    #[test]
+    fn a_cell_pools_its_texels_with_their_blocks() {
+        let mut field = VisibilityField::new(4);
+        let key = CellKey::new([0.0; 3], [0.0, 0.0, 1.0], 0);
+        let mut observed = FieldObservations::new(4);
+        // Many blocked rays straight up, one free ray just beside them (same 2 × 2 block),
+        // and many free rays sideways: a bright cell with a dark block.
+        let up = [0.0, 0.0, 1.0];
+        let beside = octahedral::direction_of([0.8, 0.6]);
+        let (t_up, t_beside) = (octahedral::texel_of(up, 4), octahedral::texel_of(beside, 4));
+        assert_ne!(t_up, t_beside);
+        assert_eq!(
+            (t_up / 4 / 2, t_up % 4 / 2),
+            (t_beside / 4 / 2, t_beside % 4 / 2)
+        );
+        for _ in 0..100 {
+            observed.record(key, up, false);
+        }
+        observed.record(key, beside, true);
+        for _ in 0..300 {
+            observed.record(key, [-1.0, 0.0, 0.0], true);
+        }
+        field.merge(&observed);
+        let cell = field.cell(&key).unwrap();
+        let beside_alone = texel_visibility(cell.texel(beside), cell.visibility(), PRIOR_FREE);
+        let pooled = cell.pooled_visibility_at(t_beside).expect("seen");
+        assert!(
+            pooled < 0.5 * beside_alone,
+            "{pooled} against {beside_alone}"
+        );
+        // No ray went into the top-left block (texels 0, 1, 4 and 5): the cell knows
+        // nothing there.
+        assert_eq!(cell.pooled_visibility_at(5), None);
     }
 
     #[test]

@@ -16,8 +16,8 @@
 //! | `tol` | float | 1 | the map's floor, a_min = 1/(tol·h²); `inf` for none |
 //! | `map_res` | integer | 4 | the map's height h in texels (width 2h), 1 to 1024 |
 //! | `guide_fraction` | float | 0.5; 0.75 with `map = field` | `map_use = proposal` or `both`: the guide's share of the proposal (of light sampling's environment draws, with the field), in [0, 0.99] |
-//! | `field_res` | integer | 8 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
-//! | `field_cell` | float | 4 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
+//! | `field_res` | integer | 16 | `map = field`: texels per side of a cell's equal-area octahedral map (1 to 64) |
+//! | `field_cell` | float | 16 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
 //! | `field_race` | boolean | true | `map = field`: race the field against AIS off in the second and third passes and gather the rest as AIS off where it loses, or where it finds almost nothing to guide or roll; false keeps the field for the whole render (to study it) |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
@@ -62,6 +62,12 @@ pub const PARAMETERS: [&str; 19] = [
 pub const MOST_RAYS: u32 = 1 << 20;
 /// Largest map height, in texels.
 pub const LARGEST_MAP_RES: u32 = 1024;
+
+/// A field cell's edge by default, in pixel footprints at the gather point: 16, so that a
+/// cell gathers the rays of about 16 × 16 pixels (with 256 texels per cell, smaller cells
+/// split their rays too thinly; measured with 4, 8 and 16 on the repository's scene suite,
+/// BENCHMARKS.md, section 5.6).
+pub const DEFAULT_FIELD_CELL: f32 = 16.0;
 
 /// Where a batch's affinity map starts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -298,7 +304,7 @@ impl Default for GatherSettings {
             guide_fraction: None,
             cost_ratio: None,
             field_res: ais::field::DEFAULT_SIDE,
-            field_cell: 4.0,
+            field_cell: DEFAULT_FIELD_CELL,
             field_prior: ais::field::PRIOR_FREE,
             field_race: true,
             hide_emitters: false,
