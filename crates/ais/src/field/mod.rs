@@ -14,8 +14,9 @@
 //! Cells are keyed by position on a hashed grid whose spacing the host chooses per lookup,
 //! as a power of two (so that it can follow the pixel footprint: a cell covers a few pixels
 //! wherever it is), and by the dominant axis of the normal. Each cell holds an equal-area
-//! octahedral map of `side × side` texels ([`octahedral`]). A lookup is one hash probe per
-//! gather and one texel index per candidate: O(1) whatever the scene.
+//! octahedral map of `side × side` texels ([`octahedral`]), whose visibilities are also
+//! kept pooled with their neighbours' for proposals ([`pooling`]). A lookup is one hash
+//! probe per gather and one texel index per candidate: O(1) whatever the scene.
 //!
 //! A cell may also count rays by *source*: whatever the host says a ray aimed at (one of
 //! its emitters, say), so that it can learn which sources a cell sees
@@ -479,10 +480,10 @@ impl FieldCell<'_> {
     /// The visibility of texel `index` (row-major, as [`octahedral::texel_of`] numbers
     /// them) pooled with its blocks' ([`pooling`]), or `None` where no ray of the cell went
     /// into its 2 × 2 block. Pooling lends a texel seen a few times its neighbours'
-    /// evidence, and the same rays count at every level: sharp where rays are few, and
-    /// overconfident. A proposal that keeps a defensive share can use it (a wrong estimate
-    /// costs a bounded factor in variance); roulette, whose mistakes cost 1 / a, reads
-    /// each texel's own evidence ([`FieldCell::acceptance`]).
+    /// evidence; since the same rays count at every level, the estimate is overconfident
+    /// where rays are few. A proposal that keeps a defensive share can use it (a wrong
+    /// estimate costs a bounded factor in variance); roulette, whose mistakes cost 1 / a,
+    /// reads each texel's own evidence ([`FieldCell::acceptance`]).
     pub fn pooled_visibility_at(&self, index: usize) -> Option<f32> {
         let estimate = *self.pooled.get(index)?;
         pooling::block_seen(self.counts, self.side, index).then_some(estimate)
