@@ -27,10 +27,10 @@ use std::collections::HashMap;
 use std::sync::Arc;
 
 /// A cell is guided only where fewer than this share of the environment's own draws would
-/// be free (Σ P_t v_t, texels whose block no ray went to counting as blocked): where most are free
-/// (open ground, a sculpture under the sky), guiding saves little variance, makes its rays
-/// dearer (free rays cross the scene) and, where a bright light is partly hidden within a
-/// texel, adds variance. Measured on the default scene: guided everywhere it had contrast,
+/// be free (Σ P_t v_t, texels whose block no ray went to counting as blocked): where most
+/// are free (open ground, a sculpture under the sky), guiding saves little variance, makes
+/// its rays dearer (free rays cross the scene) and, where a bright light is partly hidden
+/// within a texel, adds variance. Measured on the default scene: guided everywhere it had contrast,
 /// auto took 34% more time for 11% more relMSE.
 pub const MOST_FREE_DRAWS: f64 = 0.5;
 
@@ -156,11 +156,10 @@ fn light_choice(power: &[f64], cell: &FieldCell, fraction: f64) -> Option<AliasT
 
 /// A texel whose 2 × 2 block no ray of a cell went to (behind the surface, or where light
 /// sampling never draws) weighs this share of the cell's visibility in its guide. Such
-/// draws are mostly
-/// below the surface's horizon, wasted: at a tenth, 2.4 of 16 candidates per gather were
-/// outside the BSDF's support in the sunlit room; at a hundredth, relMSE fell 7–8% in the
-/// sunlit and overcast rooms and stayed within noise in the courtyard and the interior
-/// (the repository's BENCHMARKS.md, section 5.6). Not zero: a direction that some point of
+/// draws are mostly below the surface's horizon, wasted: at a tenth, 2.4 of 16 candidates
+/// per gather were outside the BSDF's support in the sunlit room; at a hundredth, relMSE
+/// fell 7–8% in the sunlit and overcast rooms and stayed within noise in the courtyard and
+/// the interior (the repository's BENCHMARKS.md, section 5.6). Not zero: a direction that some point of
 /// the cell sees but no ray tried keeps a chance beyond the defensive share.
 pub const UNSEEN_TEXEL_SHARE: f32 = 0.01;
 
