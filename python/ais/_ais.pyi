@@ -141,7 +141,7 @@ def compare(
 class VisibilityField:
     """The extension's learned field; use ``ais.VisibilityField``, which converts arrays."""
 
-    def __init__(self, side: int = 16, prior: float = 2.0) -> None: ...
+    def __init__(self, side: int = 8, prior: float = 2.0) -> None: ...
     def acceptance(
         self,
         positions: npt.NDArray[np.float32],

@@ -95,14 +95,14 @@ class VisibilityField:
     """A visibility field learned over many gathers, fixed while a pass renders.
 
     Each gather's cell is keyed by its position, its normal and ``spacing`` (the distance
-    between neighbouring gathers there, e.g. sixteen pixel footprints); each cell holds an
+    between neighbouring gathers there, e.g. four pixel footprints); each cell holds an
     equal-area map of ``side × side`` texels counting free and blocked rays. In a pass:
     ``acceptance(...)`` before ``BatchSet.decide(..., acceptance=...)``, ``record(...)``
     for the traced rays, and ``end_pass()`` after the pass. ``cost_ratio`` is what a
     candidate costs besides tracing, over what tracing it costs.
     """
 
-    def __init__(self, side: int = 16, prior: float = 2.0) -> None:
+    def __init__(self, side: int = 8, prior: float = 2.0) -> None:
         self._field = _VisibilityField(int(side), float(prior))
 
     def acceptance(self, positions, normals, spacings, directions, cost_ratio: float) -> Array:

@@ -161,11 +161,11 @@ pub struct VisibilityField {
     expected_rejection: Vec<f32>,
 }
 
-/// Texels per side of a cell's map by default: 256 texels of 0.05 sr each (a window a few
-/// metres away fills a few of them). Finer maps learn more slowly; pooling their texels
-/// with their blocks ([`pooling`]) is what makes this size pay (measured on the rooms of the
-/// repository's scene suite: BENCHMARKS.md, section 5.6).
-pub const DEFAULT_SIDE: u32 = 16;
+/// Texels per side of a cell's map by default: 64 texels of 0.2 sr each, for a host that
+/// uses the field for roulette, which reads each texel's own counts (finer texels learn
+/// more slowly, so roulette skips less). A host that guides its proposal with the pooled
+/// visibilities can afford finer maps: the renderer of this repository uses 16.
+pub const DEFAULT_SIDE: u32 = 8;
 
 impl Default for VisibilityField {
     fn default() -> Self {

@@ -63,6 +63,12 @@ pub const MOST_RAYS: u32 = 1 << 20;
 /// Largest map height, in texels.
 pub const LARGEST_MAP_RES: u32 = 1024;
 
+/// Texels per side of a field cell's map by default: 256 texels of 0.05 sr each (a window a
+/// few metres away fills a few of them). Finer maps learn more slowly; pooling their texels
+/// with their blocks ([`ais::field::pooling`]) is what makes this size pay for the guides
+/// (measured on the repository's scene suite: BENCHMARKS.md, section 5.6).
+pub const DEFAULT_FIELD_RES: u32 = 16;
+
 /// A field cell's edge by default, in pixel footprints at the gather point: 16, so that a
 /// cell gathers the rays of about 16 × 16 pixels (with 256 texels per cell, smaller cells
 /// split their rays too thinly; measured with 4, 8 and 16 on the repository's scene suite,
@@ -303,7 +309,7 @@ impl Default for GatherSettings {
             map_height: map.height,
             guide_fraction: None,
             cost_ratio: None,
-            field_res: ais::field::DEFAULT_SIDE,
+            field_res: DEFAULT_FIELD_RES,
             field_cell: DEFAULT_FIELD_CELL,
             field_prior: ais::field::PRIOR_FREE,
             field_race: true,
