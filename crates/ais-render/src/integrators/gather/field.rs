@@ -168,6 +168,8 @@ pub struct GatherLearning {
     race: Race,
     /// The race's result, once its passes ended.
     race_result: Option<RaceResult>,
+    /// Gathers the field guided in the race passes so far.
+    race_guided: u64,
     /// Whether the field may stand aside (`field_race`).
     may_stand_aside: bool,
 }
@@ -189,6 +191,7 @@ impl GatherLearning {
             passes: 0,
             race: Race::new(world.resolution.0 as usize, world.resolution.1 as usize),
             race_result: None,
+            race_guided: 0,
             may_stand_aside: settings.field_race,
         }
     }
@@ -260,9 +263,13 @@ impl Learning for GatherLearning {
         if self.passes > 0 && self.guided[1] > 0 {
             self.guided_share = Some(self.guided[0] as f64 / self.guided[1] as f64);
         }
+        if RACE_PASSES.contains(&self.passes) {
+            self.race_guided += self.guided[0];
+        }
         self.guided = [0; 2];
         if self.passes == *RACE_PASSES.end() {
-            self.race_result = self.race.result();
+            let guided = self.race_guided > 0;
+            self.race_result = self.race.result().map(|race| RaceResult { guided, ..race });
             self.race = Race::default(); // its image-sized sums are no longer needed
         }
         self.passes += 1;

@@ -20,7 +20,8 @@
 //! does not show: there each arm's pixels are also timed, and the field is kept only if
 //! its variance times its time per sample is below AIS off's (such renders already depend
 //! on timings, through the measured cost ratio; with the cost ratio pinned, they do not
-//! race). The arms' pixels are interleaved in space and in time, so the machine's drifting
+//! race); a field that only rolled is kept only for time it saves
+//! ([`RaceResult::field_pays`]). The arms' pixels are interleaved in space and in time, so the machine's drifting
 //! speed falls on both alike. Where the field loses, the rest of the render gathers as AIS
 //! off, with no field work at all. Choosing how later passes gather from what earlier
 //! passes saw keeps every pass unbiased.
@@ -176,15 +177,28 @@ pub struct RaceResult {
     pub off: f64,
     /// Seconds per sample of the field's arm and of AIS off's, where the race was timed.
     pub seconds_per_sample: Option<[f64; 2]>,
+    /// Whether the field's arm guided any gather (else it only rolled).
+    pub guided: bool,
 }
 
 impl RaceResult {
     /// Whether the field pays: its variance times its time per sample below AIS off's
     /// where timed; else its variance times [`RACE_MARGIN`] below AIS off's.
+    ///
+    /// A field that only rolled cannot have lowered the variance of a sample (skipping
+    /// candidates only adds to it): a lower variance in its arm is the race's own noise
+    /// (±20% between the arms' pixels, which differ). So there its variance counts as at
+    /// least AIS off's, and it is kept only for time it saves. (A room lit through a door
+    /// gap read 0.78–0.92 at equal time and ended 8% worse at equal time.)
     pub fn field_pays(&self) -> bool {
+        let field = if self.guided {
+            self.field
+        } else {
+            self.field.max(self.off)
+        };
         match self.seconds_per_sample {
-            Some([field, off]) => self.field * field < self.off * off,
-            None => self.field * RACE_MARGIN < self.off,
+            Some([field_seconds, off_seconds]) => field * field_seconds < self.off * off_seconds,
+            None => field * RACE_MARGIN < self.off,
         }
     }
 }
@@ -235,6 +249,7 @@ impl Race {
             field: field[0] / field[1],
             off: off[0] / off[1],
             seconds_per_sample: self.seconds_per_sample(),
+            guided: true,
         })
     }
 
@@ -351,6 +366,7 @@ mod tests {
                 field,
                 off,
                 seconds_per_sample,
+                guided: true,
             }
             .field_pays()
         };
@@ -360,6 +376,22 @@ mod tests {
         // Roulette: 20% more variance at 30% less time pays, untimed it would not.
         assert!(variance_and_time(1.2, 1.0, Some([0.7, 1.0])));
         assert!(!variance_and_time(1.2, 1.0, None));
+        // A field that only rolled is kept for time alone: its lower variance is noise.
+        let rolled_only = |field: f64, seconds_per_sample: [f64; 2]| {
+            RaceResult {
+                field,
+                off: 1.0,
+                seconds_per_sample: Some(seconds_per_sample),
+                guided: false,
+            }
+            .field_pays()
+        };
+        assert!(!rolled_only(0.8, [1.01, 1.0]), "no time saved");
+        assert!(rolled_only(0.8, [0.9, 1.0]));
+        assert!(
+            !rolled_only(1.2, [0.9, 1.0]),
+            "more variance than time saved"
+        );
     }
 
     #[test]
