@@ -21,8 +21,8 @@
 //! its variance times its time per sample is below AIS off's (such renders already depend
 //! on timings, through the measured cost ratio; with the cost ratio pinned, they do not
 //! race); a field that only rolled is kept only for time it saves
-//! ([`RaceResult::field_pays`]). The arms' pixels are interleaved in space and in time, so the machine's drifting
-//! speed falls on both alike. Where the field loses, the rest of the render gathers as AIS
+//! ([`RaceResult::field_pays`]). The arms' pixels are interleaved in space and in time, so
+//! the machine's drifting speed falls on both alike. Where the field loses, the rest of the render gathers as AIS
 //! off, with no field work at all. Choosing how later passes gather from what earlier
 //! passes saw keeps every pass unbiased.
 
@@ -189,7 +189,7 @@ impl RaceResult {
     /// candidates only adds to it): a lower variance in its arm is the race's own noise
     /// (±20% between the arms' pixels, which differ). So there its variance counts as at
     /// least AIS off's, and it is kept only for time it saves. (A room lit through a door
-    /// gap read 0.78–0.92 at equal time and ended 8% worse at equal time.)
+    /// gap read 0.78–0.92 in the race, and its render ended 8% worse at equal time.)
     pub fn field_pays(&self) -> bool {
         let field = if self.guided {
             self.field
@@ -224,7 +224,8 @@ impl Race {
     }
 
     /// Each arm's mean relMSE-weighted per-sample variance; `None` until both arms have
-    /// pixels with two samples or more.
+    /// pixels with two samples or more. The field's arm is taken to have guided
+    /// ([`RaceResult::guided`]): a host whose field only rolled says so.
     pub fn result(&self) -> Option<RaceResult> {
         let mut weighted = Vec::new(); // (races off, weighted variance) per pixel
         for y in 0..self.height.min(self.pixels.len() / self.width.max(1)) {
