@@ -207,27 +207,32 @@ impl GatherLearning {
     }
 
     /// Whether the field has no use in the rest of the render, which then gathers as AIS
-    /// off (never with `field_race` false): it lost its race; or, where it does not roll, its last pass guided fewer than
-    /// [`LEAST_GUIDED_SHARE`] of the gathers it could guide; or, where it rolls, roulette
-    /// pays for fewer than [`LEAST_ROLLING_SHARE`] of the rays before the race could end
-    /// (measured at 128 candidates: a field kept for its guiding alone then lost 3–10%
-    /// under open skies, behind a roof edge and among sphere lights).
+    /// off (never with `field_race` false): it lost its race; or, where it does not roll,
+    /// it finds little to guide ([`GatherLearning::little_use`]); or, where it rolls,
+    /// roulette pays for little before the race could end (measured at 128 candidates: a
+    /// field kept for its guiding alone then lost 3–10% under open skies, behind a roof edge
+    /// and among sphere lights).
     pub fn stands_aside(&self) -> bool {
         if !self.may_stand_aside {
             return false;
         }
         let lost_race = self.race_result.is_some_and(|race| !race.field_pays());
-        let little_use = if self.rolls {
-            self.race_result.is_none()
-                && self
-                    .field
-                    .rolling_share()
-                    .is_some_and(|share| share < LEAST_ROLLING_SHARE)
+        let before_verdict = !self.rolls || self.race_result.is_none();
+        lost_race || (before_verdict && self.little_use())
+    }
+
+    /// Whether the field found little use so far: where it rolls, roulette pays for fewer
+    /// than [`LEAST_ROLLING_SHARE`] of the rays; elsewhere its last pass guided fewer than
+    /// [`LEAST_GUIDED_SHARE`] of the gathers it could guide.
+    fn little_use(&self) -> bool {
+        if self.rolls {
+            self.field
+                .rolling_share()
+                .is_some_and(|share| share < LEAST_ROLLING_SHARE)
         } else {
             self.guided_share
                 .is_some_and(|share| share < LEAST_GUIDED_SHARE)
-        };
-        lost_race || little_use
+        }
     }
 
     /// The cost ratio the next pass uses: the settings' `cost_ratio` if given, else the one
@@ -283,16 +288,9 @@ impl Learning for GatherLearning {
         if self.stands_aside() {
             return false;
         }
-        // After the race (or without one), as much use as it takes to stand aside stops
+        // After the race (or without one), as little use as it takes to stand aside stops
         // the learning but keeps the field.
-        if self.rolls {
-            self.field
-                .rolling_share()
-                .is_none_or(|share| share >= LEAST_ROLLING_SHARE)
-        } else {
-            self.guided_share
-                .is_none_or(|share| share >= LEAST_GUIDED_SHARE)
-        }
+        !self.little_use()
     }
 }
 

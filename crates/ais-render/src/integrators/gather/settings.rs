@@ -410,6 +410,7 @@ fn number<T: std::str::FromStr>(value: &str, what: &str) -> Result<T, String> {
         .map_err(|_| format!("{what} \"{value}\" is not a number of the right kind"))
 }
 
+/// Parses "true" or "false"; the error names the parameter `what`.
 fn boolean(value: &str, what: &str) -> Result<bool, String> {
     match value.trim() {
         "true" => Ok(true),
