@@ -15,7 +15,7 @@
 use super::{Environment, EnvironmentMap, Toward};
 use ais::field::octahedral;
 use ais::mapping::LatLong;
-use ais::sampling::{cumulative, invert_cumulative};
+use ais::sampling::{cumulative, guide_table, invert_guided};
 use glam::Vec3;
 use std::sync::{Arc, Mutex};
 
@@ -66,6 +66,9 @@ enum TexelContents {
         /// `within[start[t] + t..][..n_t + 1]` with `n_t` its cells (drawn by inversion,
         /// which keeps stratified numbers stratified).
         within: Vec<f64>,
+        /// Per texel, the guide table of its cumulative probabilities (`n_t` entries from
+        /// `start[t]`), so that an inversion looks at a bin or two.
+        within_guides: Vec<u32>,
     },
     /// A constant environment's uniform directions over equal-area octahedral texels: a
     /// point uniform in the texel's square is uniform over its solid angle.
@@ -123,6 +126,13 @@ impl EnvironmentPartition {
                 within.extend((0..=probabilities.len()).map(|k| k as f64 / n));
             }
         }
+        let within_guides = (0..texels)
+            .flat_map(|t| {
+                let count = (start[t + 1] - start[t]) as usize;
+                let first = start[t] as usize + t;
+                guide_table(&within[first..first + count + 1])
+            })
+            .collect();
         EnvironmentPartition {
             layout,
             contents: TexelContents::Cells {
@@ -130,6 +140,7 @@ impl EnvironmentPartition {
                 cells,
                 start,
                 within,
+                within_guides,
             },
             texel_mass,
         }
@@ -167,7 +178,11 @@ impl EnvironmentPartition {
                 cells,
                 start,
                 within,
-            } => 4 * (cell_texel.len() + cells.len() + start.len()) + 8 * within.len(),
+                within_guides,
+            } => {
+                4 * (cell_texel.len() + cells.len() + start.len() + within_guides.len())
+                    + 8 * within.len()
+            }
             TexelContents::Uniform { .. } => 0,
         };
         std::mem::size_of_val(self) + cells + 8 * self.texel_mass.len()
@@ -182,13 +197,15 @@ impl EnvironmentPartition {
                     cells,
                     start,
                     within,
+                    within_guides,
                     ..
                 },
                 Environment::Map(map),
             ) => {
                 let first = start[t] as usize + t;
                 let count = (start[t + 1] - start[t]) as usize;
-                let (i, fx) = invert_cumulative(&within[first..first + count + 1], v as f64);
+                let guide = &within_guides[start[t] as usize..][..count];
+                let (i, fx) = invert_guided(&within[first..first + count + 1], guide, v as f64);
                 let cell = cells[start[t] as usize + i] as usize;
                 map.toward_in_cell(cell, [fx, w.min(ONE_BELOW)])
             }
@@ -260,6 +277,8 @@ pub struct EnvironmentGuide {
     /// Per batch: the affinity of each texel, the cumulative of `A_t P_t / Z`, and `Z`.
     affinity: Vec<f32>,
     cdf: Vec<f64>,
+    /// The guide table of `cdf` ([`guide_table`]).
+    cdf_guide: Vec<u32>,
     normaliser: f64,
     /// The product's share β of the defensive mixture `(1 − β) p_env + β p_env A / Z`.
     fraction: f64,
@@ -274,6 +293,7 @@ impl EnvironmentGuide {
             partition,
             affinity: vec![1.0; texels],
             cdf: vec![0.0; texels + 1],
+            cdf_guide: Vec::with_capacity(texels),
             normaliser: 1.0,
             fraction: 1.0,
         };
@@ -284,7 +304,9 @@ impl EnvironmentGuide {
     /// Bytes held by this thread's part (the shared partition is counted once, in
     /// [`EnvironmentPartition::memory_bytes`]).
     pub fn memory_bytes(&self) -> usize {
-        std::mem::size_of_val(self) + 4 * self.affinity.len() + 8 * self.cdf.len()
+        std::mem::size_of_val(self)
+            + 4 * (self.affinity.len() + self.cdf_guide.capacity())
+            + 8 * self.cdf.len()
     }
 
     /// The layout the cells are grouped by.
@@ -315,6 +337,8 @@ impl EnvironmentGuide {
         self.normaliser = running;
         self.cdf.iter_mut().for_each(|c| *c /= running);
         *self.cdf.last_mut().expect("at least one texel") = 1.0;
+        self.cdf_guide.clear();
+        self.cdf_guide.extend(guide_table(&self.cdf));
     }
 
     /// How much more often the mixture draws texel `t` than the environment alone:
@@ -338,14 +362,7 @@ impl EnvironmentGuide {
             let rescaled = ((u0 - beta) / (1.0 - beta)).clamp(0.0, 1.0 - 1e-7);
             return environment.sample_toward([rescaled as f32, u[1]]);
         }
-        let u0 = u0 / beta;
-        let texels = self.affinity.len();
-        let mut t = self.cdf[1..].partition_point(|&c| c <= u0).min(texels - 1);
-        while t > 0 && self.cdf[t + 1] <= self.cdf[t] {
-            t -= 1; // rounding at u ≈ 1: back to a texel with mass
-        }
-        let share = self.cdf[t + 1] - self.cdf[t];
-        let v = ((u0 - self.cdf[t]) / share).clamp(0.0, 1.0) as f32;
+        let (t, v) = invert_guided(&self.cdf, &self.cdf_guide, u0 / beta);
         self.partition.sample_in_texel(environment, t, v, u[1])
     }
 

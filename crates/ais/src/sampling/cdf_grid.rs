@@ -54,8 +54,9 @@ pub fn invert_cumulative(cdf: &[f64], u: f64) -> (usize, f32) {
 }
 
 /// The guide table of `cdf` (as [`invert_cumulative`] reads it): for each `k` of its `n`
-/// bins, the bin holding `k / n`.
-fn guide_table(cdf: &[f64]) -> impl Iterator<Item = u32> + '_ {
+/// bins, the bin holding `k / n`. With it, [`invert_guided`] usually looks at one or two
+/// bins.
+pub fn guide_table(cdf: &[f64]) -> impl Iterator<Item = u32> + '_ {
     let bins = cdf.len() - 1;
     let mut bin = 0;
     (0..bins).map(move |k| {
@@ -67,9 +68,10 @@ fn guide_table(cdf: &[f64]) -> impl Iterator<Item = u32> + '_ {
     })
 }
 
-/// [`invert_cumulative`] searching only between the bins its guide table gives for `u`.
+/// [`invert_cumulative`] searching only between the bins its guide table
+/// ([`guide_table`]) gives for `u`: the same answer, found in a step or two.
 #[inline]
-fn invert_guided(cdf: &[f64], guide: &[u32], u: f64) -> (usize, f32) {
+pub fn invert_guided(cdf: &[f64], guide: &[u32], u: f64) -> (usize, f32) {
     let bins = cdf.len() - 1;
     let k = ((u.max(0.0) * bins as f64) as usize).min(bins - 1);
     let low = guide[k] as usize;

@@ -15,7 +15,7 @@ pub mod texel_distribution;
 pub mod warp;
 
 pub use alias::AliasTable;
-pub use cdf_grid::{cumulative, invert_cumulative, CdfGrid};
+pub use cdf_grid::{cumulative, guide_table, invert_cumulative, invert_guided, CdfGrid};
 pub use distribution::{Distribution1D, Distribution2D};
 pub use texel_distribution::TexelDistribution;
 pub use warp::{cosine_hemisphere, uniform_sphere};
