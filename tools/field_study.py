@@ -6,7 +6,10 @@
     SEEDS=5 .venv/bin/python tools/field_study.py 80x60 sunlit_room,interior off,auto 16,128
 
 A configuration is an `--ais` preset, optionally followed by flags after `+`
-(`auto+--cost-ratio=2`).
+(`auto+--cost-ratio=2`). FLAGS (an environment variable) adds flags to every render, the
+reference's included (`FLAGS=--hide-emitters=true` measures the gathers' noise alone:
+what the camera sees of the sky directly is black in every image; its reference is cached
+apart).
 
 For each scene of scenes/ (names without .xml; `default` is the built-in scene), a reference is rendered once by ais with AIS
 off at 1024 spp and 16 rays (cached in target/field-study/). Then every configuration renders
@@ -32,6 +35,8 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 # AIS_BINARY picks another build (to compare two versions of the renderer).
 AIS = os.environ.get('AIS_BINARY', os.path.join(ROOT, 'target', 'release', 'ais'))
 WORK = os.path.join(ROOT, 'target', 'field-study')
+# Flags for every render, the reference's included.
+FLAGS = os.environ.get('FLAGS', '').split()
 SPP_FOR = {16: 32, 128: 8}
 
 
@@ -43,7 +48,7 @@ def render(scene, size, spp, rays, config, seed, out):
     source = [] if scene == 'default' else [os.path.join(ROOT, 'scenes', scene + '.xml')]
     command = [AIS, 'render', *source, '--resolution', size,
                '--spp', str(spp), '--rays', str(rays), '--ais', ais, '--seed', str(seed),
-               '--no-preview', '-o', out, *flags]
+               '--no-preview', '-o', out, *FLAGS, *flags]
     done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode:
         sys.exit(done.stderr)
@@ -64,7 +69,8 @@ def main():
     seeds = int(os.environ.get('SEEDS', '8'))
     os.makedirs(WORK, exist_ok=True)
     for scene in scenes:
-        reference_path = os.path.join(WORK, f'reference-{scene}-{size}.exr')
+        variant = ''.join('-' + flag.lstrip('-').replace('=', '-') for flag in FLAGS)
+        reference_path = os.path.join(WORK, f'reference-{scene}-{size}{variant}.exr')
         if not os.path.exists(reference_path):
             render(scene, size, 1024, 16, 'off', 777, reference_path)
         reference = np.array(mi.Bitmap(reference_path))[..., :3].astype(np.float64)
