@@ -7,9 +7,8 @@
 
 A configuration is an `--ais` preset, optionally followed by flags after `+`
 (`auto+--cost-ratio=2`). FLAGS (an environment variable) adds flags to every render, the
-reference's included (`FLAGS=--hide-emitters=true` measures the gathers' noise alone:
-what the camera sees of the sky directly is black in every image; its reference is cached
-apart).
+reference's included, which is then cached apart (`FLAGS=--hide-emitters=true`: the sky
+the camera sees directly is black in every image).
 
 For each scene of scenes/ (names without .xml; `default` is the built-in scene), a reference is rendered once by ais with AIS
 off at 1024 spp and 16 rays (cached in target/field-study/). Then every configuration renders
