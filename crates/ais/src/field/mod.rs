@@ -320,41 +320,67 @@ impl VisibilityField {
     /// Adds what a tile observed (observations made with another `side` or number of
     /// sources are refused).
     pub fn merge(&mut self, observations: &FieldObservations) {
-        assert_eq!(
-            (observations.side, observations.sources),
-            (self.side, self.sources),
-            "observations of another map size"
-        );
-        let (texels, stride) = ((self.side * self.side) as usize, self.stride());
-        if !observations.cells.is_empty() {
+        self.merge_all([observations]);
+    }
+
+    /// Adds what several tiles observed (a pass's), then works out each cell they touched
+    /// once: the same field as merging them one by one, in any order, for less work (a
+    /// cell that several tiles saw is pooled once, not once per tile).
+    pub fn merge_all<'o>(&mut self, all: impl IntoIterator<Item = &'o FieldObservations>) {
+        let mut touched = Vec::new();
+        for observations in all {
+            assert_eq!(
+                (observations.side, observations.sources),
+                (self.side, self.sources),
+                "observations of another map size"
+            );
+            for (key, seen) in &observations.cells {
+                touched.push(self.add(*key, seen));
+            }
+        }
+        if !touched.is_empty() {
             self.planned = None;
         }
-        for (key, seen) in &observations.cells {
-            let next = self.counts.len() as u32;
-            let first = *self.cells.entry(*key).or_insert_with(|| next) as usize;
-            if first == next as usize {
-                self.counts.resize(first + stride, TexelCounts::default());
-                self.totals.push(TexelCounts::default());
-                self.pooled.resize(self.pooled.len() + texels, 1.0);
-                self.darkest.push(1.0);
-            }
-            let index = first / stride;
-            for (slot, &count) in seen.iter().enumerate() {
-                self.counts[first + slot].add(count);
-                if slot < texels {
-                    self.totals[index].add(count);
-                }
-            }
-            let counts = &self.counts[first..first + texels];
-            let cell = visibility(self.totals[index], self.prior);
-            self.darkest[index] = counts
-                .iter()
-                .map(|&c| texel_visibility(c, cell, self.prior))
-                .fold(1.0, f32::min);
-            self.pooled[index * texels..(index + 1) * texels].copy_from_slice(
-                &pooling::pooled_visibilities(counts, self.side, cell, self.prior),
-            );
+        touched.sort_unstable();
+        touched.dedup();
+        for index in touched {
+            self.pool(index);
         }
+    }
+
+    /// Adds `seen` to the counts of cell `key` (made if new); returns its index.
+    fn add(&mut self, key: CellKey, seen: &[TexelCounts]) -> usize {
+        let (texels, stride) = ((self.side * self.side) as usize, self.stride());
+        let next = self.counts.len() as u32;
+        let first = *self.cells.entry(key).or_insert_with(|| next) as usize;
+        if first == next as usize {
+            self.counts.resize(first + stride, TexelCounts::default());
+            self.totals.push(TexelCounts::default());
+            self.pooled.resize(self.pooled.len() + texels, 1.0);
+            self.darkest.push(1.0);
+        }
+        let index = first / stride;
+        for (slot, &count) in seen.iter().enumerate() {
+            self.counts[first + slot].add(count);
+            if slot < texels {
+                self.totals[index].add(count);
+            }
+        }
+        index
+    }
+
+    /// Works out cell `index`'s darkest texel and pooled visibilities from its counts.
+    fn pool(&mut self, index: usize) {
+        let (texels, stride) = ((self.side * self.side) as usize, self.stride());
+        let counts = &self.counts[index * stride..index * stride + texels];
+        let cell = visibility(self.totals[index], self.prior);
+        self.darkest[index] = counts
+            .iter()
+            .map(|&c| texel_visibility(c, cell, self.prior))
+            .fold(1.0, f32::min);
+        self.pooled[index * texels..(index + 1) * texels].copy_from_slice(
+            &pooling::pooled_visibilities(counts, self.side, cell, self.prior),
+        );
     }
 }
 
@@ -748,10 +774,19 @@ mod tests {
         tiles.iter().for_each(|o| forward.merge(o));
         let mut backward = VisibilityField::new(8);
         tiles.iter().rev().for_each(|o| backward.merge(o));
+        let mut together = VisibilityField::new(8);
+        together.merge_all(&tiles);
+        let texel = octahedral::texel_of([0.6, 0.8, 0.0], 8);
         for key in &keys {
             let (f, b) = (forward.cell(key).unwrap(), backward.cell(key).unwrap());
             assert_eq!(f.total(), b.total());
             assert_eq!(f.texel([0.6, 0.8, 0.0]), b.texel([0.6, 0.8, 0.0]));
+            let t = together.cell(key).unwrap();
+            assert_eq!(t.total(), f.total());
+            assert_eq!(t.darkest(), f.darkest());
+            assert!(t.darkest() < 1.0, "pooled and worked out");
+            assert_eq!(t.pooled_visibility_at(texel), f.pooled_visibility_at(texel));
+            assert_eq!(t.pooled_visibility_at(texel), b.pooled_visibility_at(texel));
         }
     }
 

@@ -154,6 +154,9 @@ pub struct GatherLearning {
     pub field: Arc<VisibilityField>,
     /// The timings of every pass so far.
     pub cost: CostSample,
+    /// The tiles' observations of the pass being merged, added to the field together when
+    /// it ends.
+    pending: Vec<FieldObservations>,
     /// The settings' `cost_ratio`, if pinned.
     pinned_cost_ratio: Option<f32>,
     /// Whether the gathers roll ([`field_rolls`]).
@@ -184,6 +187,7 @@ impl GatherLearning {
         GatherLearning {
             field: Arc::new(field),
             cost: CostSample::default(),
+            pending: Vec::new(),
             pinned_cost_ratio: settings.cost_ratio,
             rolls: field_rolls(settings),
             guided: [0; 2],
@@ -249,8 +253,7 @@ impl Learning for GatherLearning {
 
     fn merge(&mut self, observed: Option<FieldPass>) {
         if let Some(pass) = observed {
-            // The pass's tiles have dropped their handles: no copy is made.
-            Arc::make_mut(&mut self.field).merge(&pass.observations);
+            self.pending.push(pass.observations);
             self.cost.add(pass.cost);
             self.guided[0] += pass.guided[0];
             self.guided[1] += pass.guided[1];
@@ -263,7 +266,10 @@ impl Learning for GatherLearning {
     /// Plans the next pass's roulette at its cost ratio: which cells it pays in.
     fn end_pass(&mut self) {
         let cost_ratio = self.cost_ratio();
-        Arc::make_mut(&mut self.field).plan(cost_ratio);
+        // The pass's tiles have dropped their handles: no copy is made.
+        let field = Arc::make_mut(&mut self.field);
+        field.merge_all(&std::mem::take(&mut self.pending));
+        field.plan(cost_ratio);
         // The first pass reads an empty field: it guides nothing and says nothing.
         if self.passes > 0 && self.guided[1] > 0 {
             self.guided_share = Some(self.guided[0] as f64 / self.guided[1] as f64);
