@@ -29,7 +29,7 @@
 //! ```
 
 use crate::affinity_map::{AffinityMap, Lookup, MapConfig, MapConfigError};
-use crate::epochs::EpochPlan;
+use crate::epochs::{EpochPlan, MAX_EPOCHS};
 use crate::halton::ScrambledHalton;
 use crate::rng::Pcg32;
 use crate::stats::Stats;
@@ -213,6 +213,8 @@ pub struct Estimate<V> {
 struct Pending {
     lookup: Option<Lookup>,
     affinity: f32,
+    /// The epoch it was drawn in, whose sum its contribution joins.
+    epoch: usize,
 }
 
 /// A recorded ray held back until its epoch ends.
@@ -272,17 +274,21 @@ pub struct Batch<V: Value> {
     epoch: usize,
     /// Candidates the current epoch may draw (the budget, or the cap).
     epoch_limit: u32,
-    previous_epoch_traced: u32,
+    previous_epoch_accepted: u32,
     previous_epoch_candidates: u32,
-    epoch_traced: u32,
     epoch_candidates: u32,
     epoch_accepted: u32,
-    epoch_sum: V,
-    total: V,
+    /// Each epoch's sum of weighted contributions, recorded in the order decided.
+    epoch_sums: [V; MAX_EPOCHS],
+    /// Each closed epoch's weight `n_e / n / candidates` (None: it drew no candidate).
+    epoch_weights: [Option<f64>; MAX_EPOCHS],
     next_index: u32,
     /// The current candidate's acceptance number u3.
     acceptance: f32,
-    pending: Option<Pending>,
+    /// Candidates decided for tracing, in order; those from `recorded` on await their
+    /// record (at most one unless the batch decides ahead).
+    pending: Vec<Pending>,
+    recorded: usize,
     done: bool,
     batch_stats: Stats,
     stats: Stats,
@@ -327,16 +333,16 @@ impl<V: Value> Batch<V> {
             seed: 0,
             epoch: 0,
             epoch_limit: 0,
-            previous_epoch_traced: 0,
+            previous_epoch_accepted: 0,
             previous_epoch_candidates: 0,
-            epoch_traced: 0,
             epoch_candidates: 0,
             epoch_accepted: 0,
-            epoch_sum: V::zero(),
-            total: V::zero(),
+            epoch_sums: [V::zero(); MAX_EPOCHS],
+            epoch_weights: [None; MAX_EPOCHS],
             next_index: 0,
             acceptance: 0.0,
-            pending: None,
+            pending: Vec::new(),
+            recorded: 0,
             done: true,
             batch_stats: Stats::default(),
             stats: Stats::default(),
@@ -390,6 +396,26 @@ impl<V: Value> Batch<V> {
         self.map.as_mut()
     }
 
+    /// Whether the host may decide further candidates before recording those it traces:
+    /// true when no decision can depend on an earlier one's outcome (no map, or a map that
+    /// does not learn, under the candidate-budget or fixed-candidates rule). A host can then
+    /// draw and decide a run of candidates, trace their rays together, and record them in
+    /// the order decided; the estimate is the same, to the bit, as deciding and recording
+    /// one at a time.
+    pub fn decides_ahead(&self) -> bool {
+        let outcomes_unused = self.map.is_none() || self.config.learning == Learning::Off;
+        let stopping_fixed = matches!(
+            self.config.stopping,
+            Stopping::CandidateBudget | Stopping::FixedCandidates
+        );
+        outcomes_unused && stopping_fixed
+    }
+
+    /// Candidates decided for tracing whose [`Batch::record`] has not come yet.
+    pub fn awaiting_record(&self) -> usize {
+        self.pending.len() - self.recorded
+    }
+
     /// Counts over every batch finished so far.
     pub fn stats(&self) -> &Stats {
         &self.stats
@@ -428,10 +454,12 @@ impl<V: Value> Batch<V> {
         self.n = n;
         self.seed = seed;
         self.epoch = 0;
-        self.previous_epoch_traced = 0;
+        self.previous_epoch_accepted = 0;
         self.previous_epoch_candidates = 0;
-        self.total = V::zero();
-        self.pending = None;
+        self.epoch_sums = [V::zero(); MAX_EPOCHS];
+        self.epoch_weights = [None; MAX_EPOCHS];
+        self.pending.clear();
+        self.recorded = 0;
         self.done = false;
         self.batch_stats = Stats {
             batches: 1,
@@ -444,9 +472,7 @@ impl<V: Value> Batch<V> {
     /// how many candidates it may draw.
     fn start_epoch(&mut self) {
         self.epoch_candidates = 0;
-        self.epoch_traced = 0;
         self.epoch_accepted = 0;
-        self.epoch_sum = V::zero();
         self.next_index = 0;
         let size = self.plan.sizes()[self.epoch];
         let cap = self.config.candidate_cap.saturating_mul(size);
@@ -455,7 +481,7 @@ impl<V: Value> Batch<V> {
                 // The previous epoch's acceptance rate (with one accepted pseudo-candidate so that
                 // a tiny epoch cannot give 0): it depends only on the past, so the budget is
                 // fixed given the past, and it reflects the most recent map.
-                let rate = (self.previous_epoch_traced + 1) as f64
+                let rate = (self.previous_epoch_accepted + 1) as f64
                     / (self.previous_epoch_candidates + 1) as f64;
                 ((size as f64 / rate).ceil() as u32).clamp(size, cap)
             }
@@ -475,7 +501,8 @@ impl<V: Value> Batch<V> {
     /// batch is complete.
     ///
     /// # Panics
-    /// If the previous candidate was accepted for tracing but not recorded.
+    /// If a candidate accepted for tracing is not recorded yet, unless the batch
+    /// [decides ahead](Batch::decides_ahead).
     pub fn next_candidate(&mut self) -> Option<Candidate> {
         self.advance()?;
         let index = self.next_index - 1;
@@ -498,7 +525,8 @@ impl<V: Value> Batch<V> {
     /// the map, as the built-in placements are.
     ///
     /// # Panics
-    /// If the previous candidate was accepted for tracing but not recorded.
+    /// If a candidate accepted for tracing is not recorded yet, unless the batch
+    /// [decides ahead](Batch::decides_ahead).
     pub fn next_candidate_with(&mut self, u: [f32; 3]) -> Option<Candidate> {
         self.advance()?;
         self.acceptance = u[2];
@@ -512,7 +540,7 @@ impl<V: Value> Batch<V> {
     /// when the batch is complete.
     fn advance(&mut self) -> Option<()> {
         assert!(
-            self.pending.is_none(),
+            self.awaiting_record() == 0 || self.decides_ahead(),
             "Batch::record must follow a Decision::Trace before the next candidate"
         );
         if !self.done && self.epoch_candidates >= self.epoch_limit {
@@ -582,7 +610,11 @@ impl<V: Value> Batch<V> {
             return Decision::Reject(RejectReason::Dropped);
         }
         self.epoch_accepted += 1;
-        self.pending = Some(Pending { lookup, affinity });
+        self.pending.push(Pending {
+            lookup,
+            affinity,
+            epoch: self.epoch,
+        });
         Decision::Trace {
             weight: 1.0 / affinity,
         }
@@ -594,18 +626,19 @@ impl<V: Value> Batch<V> {
     /// applies the 1/affinity weight itself); `rating` ∈ [0, 1] is actual over unoccluded
     /// radiance (see [`rating`]).
     ///
+    /// Candidates decided ahead are recorded in the order they were decided.
+    ///
     /// # Panics
-    /// If the current candidate was not accepted for tracing.
+    /// If no candidate accepted for tracing awaits its record.
     pub fn record(&mut self, contribution: V, rating: f32) {
-        let pending = self
+        let pending = *self
             .pending
-            .take()
+            .get(self.recorded)
             .expect("Batch::record called without a Decision::Trace");
+        self.recorded += 1;
         self.batch_stats.traced += 1;
-        self.epoch_traced += 1;
-        self.epoch_sum = self
-            .epoch_sum
-            .add(contribution.scale(1.0 / pending.affinity as f64));
+        let sum = &mut self.epoch_sums[pending.epoch];
+        *sum = sum.add(contribution.scale(1.0 / pending.affinity as f64));
         if let (Some(observations), Some(lookup)) = (self.observations.as_mut(), pending.lookup) {
             observations.record(&lookup, rating.clamp(0.0, 1.0), pending.affinity);
         }
@@ -639,7 +672,7 @@ impl<V: Value> Batch<V> {
         let size = self.plan.sizes()[self.epoch];
         if self.epoch_candidates > 0 {
             let weight = size as f64 / self.n as f64 / self.epoch_candidates as f64;
-            self.total = self.total.add(self.epoch_sum.scale(weight));
+            self.epoch_weights[self.epoch] = Some(weight);
         }
         if let Some(map) = self.map.as_mut() {
             for update in self.deferred.drain(..) {
@@ -647,7 +680,7 @@ impl<V: Value> Batch<V> {
                 self.batch_stats.resets += outcome.resets as u64;
             }
         }
-        self.previous_epoch_traced = self.epoch_traced;
+        self.previous_epoch_accepted = self.epoch_accepted;
         self.previous_epoch_candidates = self.epoch_candidates;
         self.epoch += 1;
         if self.epoch == self.plan.sizes().len() {
@@ -663,12 +696,16 @@ impl<V: Value> Batch<V> {
     /// If the batch is not complete ([`Batch::next_candidate`] has not returned `None`).
     pub fn finish(&mut self) -> Estimate<V> {
         assert!(
-            self.done && self.pending.is_none(),
-            "Batch::finish called before next_candidate returned None"
+            self.done && self.awaiting_record() == 0,
+            "Batch::finish called before next_candidate returned None and every traced candidate was recorded"
         );
         self.stats.merge(&self.batch_stats);
+        let value = (self.epoch_sums.iter())
+            .zip(&self.epoch_weights)
+            .filter_map(|(sum, weight)| Some(sum.scale((*weight)?)))
+            .fold(V::zero(), V::add);
         Estimate {
-            value: self.total,
+            value,
             candidates: self.batch_stats.candidates as u32,
             traced: self.batch_stats.traced as u32,
             hit_cap: self.batch_stats.cap_hits > 0,
@@ -822,6 +859,111 @@ mod tests {
             Batch::<f32>::new(many_epochs).unwrap_err(),
             BatchConfigError::BadEpochCount(99)
         );
+    }
+
+    /// The test scene's candidate: a direction, whether it is in the support, and what
+    /// its traced ray brings.
+    fn test_candidate(u: [f32; 2]) -> (Vec3, bool, f32) {
+        let phi = std::f32::consts::TAU * u[1];
+        let direction = Vec3::new(phi.cos(), phi.sin(), 0.2).normalize();
+        let value = if direction.x >= 0.0 { 1.0 + u[0] } else { 0.0 };
+        (direction, u[0] < 0.8, value)
+    }
+
+    /// The host's acceptance in these tests: low toward x < 0.
+    fn test_acceptance(direction: Vec3, affinity: f32) -> f32 {
+        affinity * if direction.x < 0.0 { 0.3 } else { 1.0 }
+    }
+
+    /// Decides `ahead` candidates before recording them, in order.
+    fn drive_ahead(batch: &mut Batch<f32>, n: u32, seed: u64, ahead: usize) -> Estimate<f32> {
+        batch.begin(n, seed, MapStart::Current);
+        let mut values = Vec::new();
+        let mut complete = false;
+        while !complete {
+            values.clear();
+            while values.len() < ahead {
+                let Some(candidate) = batch.next_candidate() else {
+                    complete = true;
+                    break;
+                };
+                let (direction, in_support, value) = test_candidate(candidate.u);
+                let decision =
+                    batch.decide_with(direction, in_support, |a| test_acceptance(direction, a));
+                if let Decision::Trace { .. } = decision {
+                    values.push(value);
+                }
+            }
+            assert_eq!(batch.awaiting_record(), values.len());
+            for &value in &values {
+                batch.record(value, (value > 0.0) as u8 as f32);
+            }
+        }
+        batch.finish()
+    }
+
+    #[test]
+    fn deciding_ahead_gives_the_same_estimate_to_the_bit() {
+        let mut learner: Batch<f32> = Batch::new(BatchConfig {
+            affinity: Some(MapConfig::default()),
+            ..BatchConfig::default()
+        })
+        .unwrap();
+        drive(&mut learner, 256, 5, MapStart::Empty);
+        let mut fixed_map: Batch<f32> = Batch::new(BatchConfig {
+            affinity: Some(MapConfig::default()),
+            learning: Learning::Off,
+            ..BatchConfig::default()
+        })
+        .unwrap();
+        fixed_map
+            .map_mut()
+            .unwrap()
+            .copy_from(learner.map().unwrap());
+        let budget_without_map = BatchConfig {
+            affinity: None,
+            learning: Learning::Off,
+            ..BatchConfig::default()
+        };
+        let batches = [
+            Batch::new(BatchConfig::off()).unwrap(),
+            Batch::new(budget_without_map).unwrap(),
+            fixed_map,
+        ];
+        for (which, template) in batches.into_iter().enumerate() {
+            assert!(template.decides_ahead());
+            for (n, seed) in [(16, 1), (37, 2), (128, 3)] {
+                let mut one_by_one = template.clone();
+                let expected = drive_ahead(&mut one_by_one, n, seed, 1);
+                for ahead in [4, 16, 1000] {
+                    let mut batch = template.clone();
+                    let estimate = drive_ahead(&mut batch, n, seed, ahead);
+                    assert_eq!(
+                        estimate.value.to_bits(),
+                        expected.value.to_bits(),
+                        "batch {which}, n {n}, {ahead} ahead"
+                    );
+                    assert_eq!(estimate.candidates, expected.candidates);
+                    assert_eq!(estimate.traced, expected.traced);
+                }
+            }
+        }
+    }
+
+    #[test]
+    #[should_panic(expected = "Batch::record must follow")]
+    fn a_learning_batch_does_not_decide_ahead() {
+        let mut batch: Batch<f32> = Batch::new(BatchConfig {
+            affinity: Some(MapConfig::default()),
+            ..BatchConfig::default()
+        })
+        .unwrap();
+        assert!(!batch.decides_ahead());
+        batch.begin(8, 0, MapStart::Empty);
+        while let Some(candidate) = batch.next_candidate() {
+            let (direction, _, _) = test_candidate(candidate.u);
+            batch.decide(direction, true);
+        }
     }
 
     #[test]

@@ -3,7 +3,7 @@
 //! renderer.
 
 use super::guiding::CandidateSampler;
-use super::light::{free_radiance, Leaving, ShadowRay};
+use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
 use super::settings::GatherSettings;
 use super::strategy::GatherPoint;
 use crate::lights::{luminance, Toward};
@@ -19,6 +19,10 @@ use std::time::{Duration, Instant};
 /// snapshots of the map). The renderer itself uses `()`, which watches nothing and costs
 /// nothing.
 pub trait BatchProbe {
+    /// Whether it watches anything: a probe that does sees every candidate decided, traced
+    /// and recorded one at a time; without one, candidates may be decided ahead and traced
+    /// together.
+    const WATCHES: bool = true;
     /// A batch begins.
     fn started(&mut self) {}
     /// A candidate toward `direction` was decided (`in_support`: inside the BSDF's support).
@@ -29,7 +33,9 @@ pub trait BatchProbe {
     fn finished(&mut self, _config: &BatchConfig, _rays: u32, _seed: u64) {}
 }
 
-impl BatchProbe for () {}
+impl BatchProbe for () {
+    const WATCHES: bool = false;
+}
 
 /// What one batch runs on.
 pub struct BatchRun<'a> {
@@ -85,14 +91,94 @@ pub fn run_batch<P: BatchProbe>(
     batch: &mut Batch<[f32; 3]>,
     counts: &mut RayCounts,
     probe: &mut P,
-    mut recorder: Option<&mut CellRecorder>,
+    recorder: Option<&mut CellRecorder>,
 ) -> Vec3 {
-    let at = run.at;
     probe.started();
     batch.begin(run.settings.rays, run.seed, run.start);
     // Without a map or observations, nothing reads what a traced ray saw but its value and
     // (for a recorder) whether it was free: a blocked ray can skip the lookups its value
     // would need.
+    let value_only = batch.map().is_none() && batch.observations().is_none();
+    // Candidates can be traced together when no decision waits on an earlier outcome or
+    // value, and nothing watches or times them one by one.
+    let values_unneeded = run.field.is_some() || !run.settings.acceptance.needs_value();
+    let unwatched = !P::WATCHES && run.clock.is_none();
+    if value_only && values_unneeded && unwatched && batch.decides_ahead() {
+        run_ahead(run, batch, counts, recorder);
+    } else {
+        run_one_by_one(run, batch, counts, probe, recorder);
+    }
+    let estimate = batch.finish();
+    probe.finished(batch.config(), run.settings.rays, run.seed);
+    Vec3::from(estimate.value)
+}
+
+/// Candidates drawn and decided before their shadow rays are traced together, so that the
+/// lookups of one (the environment's tables, the BSDF) overlap those of the next instead of
+/// waiting behind a traversal.
+const AHEAD: usize = 16;
+
+/// The batch in runs of [`AHEAD`] candidates: draw and decide them, trace their rays, then
+/// look up what the free ones bring and record them in the order decided (the same
+/// estimate, to the bit, as [`run_one_by_one`]).
+fn run_ahead(
+    run: &BatchRun,
+    batch: &mut Batch<[f32; 3]>,
+    counts: &mut RayCounts,
+    mut recorder: Option<&mut CellRecorder>,
+) {
+    let mut drawn = [Toward::new(Vec3::ZERO); AHEAD];
+    let mut blocked = [None; AHEAD];
+    loop {
+        let count = draw_ahead(run, batch, &mut drawn);
+        if count == 0 {
+            return;
+        }
+        for (toward, blocked) in drawn[..count].iter_mut().zip(&mut blocked) {
+            *blocked = trace_aimed(run.world, run.at, toward, counts);
+        }
+        for (toward, blocked) in drawn[..count].iter_mut().zip(&blocked) {
+            let shadow_ray = radiance_if_free(run.world, run.at, toward, *blocked);
+            let traced = value_of(run, *toward, shadow_ray);
+            record(batch, recorder.as_deref_mut(), toward.direction, &traced);
+        }
+    }
+}
+
+/// Draws and decides candidates until [`AHEAD`] are to be traced or the batch is complete;
+/// returns how many were put in `drawn`.
+fn draw_ahead(run: &BatchRun, batch: &mut Batch<[f32; 3]>, drawn: &mut [Toward; AHEAD]) -> usize {
+    let at = run.at;
+    let mut count = 0;
+    while count < AHEAD {
+        let Some(candidate) = batch.next_candidate() else {
+            break;
+        };
+        let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
+            batch.decide(at.frame.normal, false);
+            continue;
+        };
+        let in_support = at.carries(&toward);
+        // No value-aware rule runs here: the running mean stays unused.
+        let mut values = RunningMean::default();
+        let (decision, _) = decide(run, batch, &mut values, &mut toward, in_support);
+        if let Decision::Trace { .. } = decision {
+            drawn[count] = toward;
+            count += 1;
+        }
+    }
+    count
+}
+
+/// The batch one candidate at a time: drawn, decided, traced and recorded.
+fn run_one_by_one<P: BatchProbe>(
+    run: &BatchRun,
+    batch: &mut Batch<[f32; 3]>,
+    counts: &mut RayCounts,
+    probe: &mut P,
+    mut recorder: Option<&mut CellRecorder>,
+) {
+    let at = run.at;
     let value_only = batch.map().is_none() && batch.observations().is_none();
     let mut values = RunningMean::default();
     while let Some(candidate) = batch.next_candidate() {
@@ -112,22 +198,30 @@ pub fn run_batch<P: BatchProbe>(
             } else {
                 trace(run, toward, known, counts)
             };
-            if let (Some(recorder), Some(free)) = (recorder.as_deref_mut(), traced.free) {
-                recorder.record(direction.into(), free);
-                if let Some(source) = traced.source {
-                    recorder.record_source(source, free);
-                }
-            }
-            batch.record(traced.value.to_array(), traced.rating);
+            record(batch, recorder.as_deref_mut(), direction, &traced);
             if let (Some(clock), Some(started)) = (run.clock, started) {
                 clock.set(clock.get() + started.elapsed());
             }
             probe.recorded(batch, traced.value.to_array(), traced.rating);
         }
     }
-    let estimate = batch.finish();
-    probe.finished(batch.config(), run.settings.rays, run.seed);
-    Vec3::from(estimate.value)
+}
+
+/// Records a traced candidate toward `direction` in the batch, and in `recorder` whether
+/// its ray was free.
+fn record(
+    batch: &mut Batch<[f32; 3]>,
+    recorder: Option<&mut CellRecorder>,
+    direction: Vec3,
+    traced: &Traced,
+) {
+    if let (Some(recorder), Some(free)) = (recorder, traced.free) {
+        recorder.record(direction.into(), free);
+        if let Some(source) = traced.source {
+            recorder.record_source(source, free);
+        }
+    }
+    batch.record(traced.value.to_array(), traced.rating);
 }
 
 /// What is known of a candidate before it is traced.
@@ -214,8 +308,13 @@ struct Traced {
 /// up only if its shadow ray is free. The same value as [`trace`] gives; the rating is 0,
 /// as nothing reads it (the batch has no map to learn).
 fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> Traced {
+    let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts);
+    value_of(run, toward, shadow_ray)
+}
+
+/// What an accepted candidate brings, once its shadow ray is known ([`traced_value`]).
+fn value_of(run: &BatchRun, mut toward: Toward, shadow_ray: ShadowRay) -> Traced {
     let at = run.at;
-    let shadow_ray = free_radiance(run.world, at, &mut toward, counts);
     let source = run.world.lights.source_of(&toward);
     let nothing = |free| Traced {
         value: Vec3::ZERO,

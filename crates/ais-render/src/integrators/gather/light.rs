@@ -77,19 +77,44 @@ pub fn free_radiance(
     toward: &mut Toward,
     counts: &mut RayCounts,
 ) -> ShadowRay {
+    let blocked = trace_aimed(world, at, toward, counts);
+    radiance_if_free(world, at, toward, blocked)
+}
+
+/// Whether the shadow ray of `toward` is blocked (`None`: no ray was needed, the candidate
+/// surely brings nothing). The first half of [`free_radiance`], for gathers that trace
+/// several candidates' rays before looking up what the free ones bring.
+#[inline]
+pub fn trace_aimed(
+    world: &World,
+    at: &GatherPoint,
+    toward: &mut Toward,
+    counts: &mut RayCounts,
+) -> Option<bool> {
     let target = match world.lights.aim(&at.receiver, toward) {
-        Aim::Nothing => return ShadowRay::Unneeded,
+        Aim::Nothing => return None,
         Aim::Point(target) => Some(target),
         Aim::Unbounded => None,
     };
     counts.occlusion += 1;
-    if world
-        .geometry
-        .occluded(&shadow_ray(at, toward.direction, target))
-    {
-        return ShadowRay::Blocked;
+    let ray = shadow_ray(at, toward.direction, target);
+    Some(world.geometry.occluded(&ray))
+}
+
+/// The second half of [`free_radiance`]: what `toward` (aimed by [`trace_aimed`]) brings,
+/// given whether its ray was blocked.
+#[inline]
+pub fn radiance_if_free(
+    world: &World,
+    at: &GatherPoint,
+    toward: &mut Toward,
+    blocked: Option<bool>,
+) -> ShadowRay {
+    match blocked {
+        None => ShadowRay::Unneeded,
+        Some(true) => ShadowRay::Blocked,
+        Some(false) => ShadowRay::Free(world.lights.radiance_toward(&at.receiver, toward)),
     }
-    ShadowRay::Free(world.lights.radiance_toward(&at.receiver, toward))
 }
 
 /// Light arriving at the gather point from a candidate direction, occluders included:
