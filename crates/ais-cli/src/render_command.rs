@@ -380,6 +380,11 @@ fn print_gather_summary(
             rendered.output.stats.field_cost_ratio
         );
     }
+    if let Some(share) = rendered.output.stats.mis_share {
+        println!(
+            "MIS          BSDF share {share} (learned from the first passes; AIS off uses 0.5)"
+        );
+    }
     if rendered.output.stats.field_stood_aside && rendered.output.stats.field_race.is_none() {
         println!("field        stood aside after its first passes: it found almost nothing to guide or roll, and the rest gathered as AIS off");
     }

@@ -391,9 +391,14 @@ fn every_mode_is_unbiased_with_a_fixed_candidate_budget() {
 
 /// A shipped scene at 12 × 8 pixels.
 fn small_shipped_scene(name: &str) -> World {
+    shipped_scene_at(name, (12, 8))
+}
+
+/// A shipped scene at `size` pixels.
+fn shipped_scene_at(name: &str, size: (u32, u32)) -> World {
     let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
     let mut world = World::from_description(load_scene(&scenes.join(name), &[]).unwrap()).unwrap();
-    world.set_resolution((12, 8));
+    world.set_resolution(size);
     world
 }
 
@@ -436,6 +441,29 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
         ..settings(Strategy::Mis, Preset::Auto, 16)
     };
     assert_field_agrees_with_ais_off("interior.xml", gather);
+    // In a courtyard at 32 × 20 pixels the first pass has gathers enough to choose MIS's
+    // BSDF share, which the later passes then use.
+    let world = shipped_scene_at("courtyard.xml", (32, 20));
+    let learned = render(
+        &world,
+        &Integrator::Gather(gather),
+        &small_render_settings(),
+    );
+    assert!(
+        learned.stats.mis_share.is_some(),
+        "the MIS share is learned"
+    );
+    assert_agrees_with_ais_off(&world, "courtyard.xml", gather);
+}
+
+/// The settings of the renders that test the field: 8 spp, seed 1.
+fn small_render_settings() -> RenderSettings {
+    RenderSettings {
+        samples_per_pixel: 8,
+        seed: 1,
+        progress: false,
+        crop: None,
+    }
 }
 
 /// Renders the shipped `scene` at 12 × 8 pixels with `gather` (a field preset), checks
@@ -443,23 +471,29 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
 /// with AIS off.
 fn assert_field_agrees_with_ais_off(scene: &str, gather: GatherSettings) {
     let world = small_shipped_scene(scene);
-    let off = settings(Strategy::Mis, Preset::Off, 64);
-    let reference = pixel_statistics(&world, off, 32, 16);
-    let settings = RenderSettings {
-        samples_per_pixel: 8,
-        seed: 1,
-        progress: false,
-        crop: None,
-    };
-    let output = render(&world, &Integrator::Gather(gather), &settings);
+    let output = render(
+        &world,
+        &Integrator::Gather(gather),
+        &small_render_settings(),
+    );
     let map_use = gather.map_use;
     let guided = output.stats.field_guided > 0;
     assert_eq!(guided, map_use.guides(), "{scene} {map_use:?}: guided");
     let rolled = output.stats.ais.rejected_roulette > 0;
     assert_eq!(rolled, field_rolls(&gather), "{scene} {map_use:?}: rolled");
-    let statistics = pixel_statistics(&world, gather, 8, 48);
+    assert_agrees_with_ais_off(&world, scene, gather);
+}
+
+/// Checks that every pixel of `world` rendered with `gather` agrees with AIS off.
+fn assert_agrees_with_ais_off(world: &World, scene: &str, gather: GatherSettings) {
+    let off = settings(Strategy::Mis, Preset::Off, 64);
+    let reference = pixel_statistics(world, off, 32, 16);
+    let statistics = pixel_statistics(world, gather, 8, 48);
     if let Err(message) = agreement(&statistics, &reference) {
-        panic!("{scene} {:?} {map_use:?}: {message}", gather.strategy);
+        panic!(
+            "{scene} {:?} {:?}: {message}",
+            gather.strategy, gather.map_use
+        );
     }
 }
 

@@ -13,6 +13,7 @@ use ais_render::bsdf::{
 };
 use ais_render::geometry::{Sphere, Triangle};
 use ais_render::image_io::{read_image, RgbImage};
+use ais_render::integrators::gather::strategy::MIS_BSDF_WEIGHT;
 use ais_render::integrators::gather::{GatherPoint, Strategy};
 use ais_render::lights::{
     AreaLight, AreaShape, Emitters, Environment, EnvironmentGuide, EnvironmentMap,
@@ -231,6 +232,7 @@ fn assert_guide_fits(environment: Environment, guide: &mut EnvironmentGuide, see
         wo: surface_point().wo,
         bsdf,
         lights: &lights,
+        mis_bsdf_share: MIS_BSDF_WEIGHT,
     };
     for (seed, strategy) in [(seed + 2, Strategy::Light), (seed + 3, Strategy::Mis)] {
         let p = fit_texels(
@@ -444,12 +446,13 @@ fn every_gather_proposal_fits() {
     let lights = mixed_lights();
     let surface = Surface::from(Material::default());
     let (bsdf, frame) = surface.at(&surface_point());
-    let at = GatherPoint {
+    let mut at = GatherPoint {
         receiver: Receiver::new(Vec3::ZERO),
         frame,
         wo: surface_point().wo,
         bsdf,
         lights: &lights,
+        mis_bsdf_share: MIS_BSDF_WEIGHT,
     };
     for (seed, strategy) in [
         Strategy::Uniform,
@@ -467,6 +470,17 @@ fn every_gather_proposal_fits() {
             |d| strategy.density(&at, d),
         );
         assert!(p > SIGNIFICANCE, "{strategy:?}: p = {p}");
+    }
+    // MIS with the other BSDF shares a render may learn.
+    for (seed, share) in [(20, 0.125), (21, 0.25), (22, 0.75)] {
+        at.mis_bsdf_share = share;
+        let p = fit_texels(
+            200_000,
+            seed,
+            |u| Strategy::Mis.sample(&at, u),
+            |d| Strategy::Mis.density(&at, d),
+        );
+        assert!(p > SIGNIFICANCE, "MIS, BSDF share {share}: p = {p}");
     }
 }
 

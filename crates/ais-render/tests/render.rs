@@ -220,10 +220,27 @@ fn the_default_gather_guides_without_timing_and_is_reproducible() {
         one.stats.field_guided > 0,
         "the field guides light sampling"
     );
+    assert_eq!(one.stats.mis_share, two.stats.mis_share);
     assert_eq!(
         one.stats.ais.rejected_roulette, 0,
         "nothing is rolled at n = 16"
     );
+}
+
+#[test]
+fn the_learned_mis_share_is_thread_independent() {
+    // A courtyard, where most gathers see the sky: the first pass has gathers enough to
+    // choose MIS's BSDF share, summed in tile order.
+    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
+    let description = load_scene(&scenes.join("courtyard.xml"), &[]).unwrap();
+    let mut world = World::from_description(description).unwrap();
+    world.set_resolution((40, 24));
+    let auto = Integrator::Gather(GatherSettings::default());
+    let one = on_threads(&world, 1, auto);
+    let two = on_threads(&world, 2, auto);
+    assert!(one.stats.mis_share.is_some(), "the MIS share is learned");
+    assert_eq!(one.stats.mis_share, two.stats.mis_share);
+    assert_eq!(bits(&one.image), bits(&two.image));
 }
 
 #[test]
@@ -277,6 +294,7 @@ fn raced(world: &World, spread: impl Fn(usize, usize) -> f32) -> gather::GatherL
             cost: Default::default(),
             guided: [1, 1],
             moments: (pass > 0).then_some(moments),
+            shares: None,
         }));
         learning.end_pass();
     }

@@ -3,7 +3,7 @@
 use ais::{Batch, BatchConfig, Learning, Stopping};
 use ais_render::integrators::gather::guiding::CandidateSampler;
 use ais_render::integrators::gather::{
-    gather_point, run_batch, BatchProbe, BatchRun, GatherSettings, Preset,
+    gather_point, run_batch, BatchProbe, BatchRun, GatherSettings, Lessons, Preset,
 };
 use ais_render::render::RayCounts;
 use ais_render::world::World;
@@ -72,7 +72,7 @@ pub fn snapshots(
         &mut batch,
         &mut RayCounts::default(),
         &mut snapshots,
-        None,
+        Lessons::default(),
     );
     Some(snapshots.taken)
 }

@@ -4,6 +4,7 @@
 
 use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
+use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
 use super::strategy::GatherPoint;
 use crate::lights::{luminance, Toward};
@@ -66,6 +67,16 @@ pub struct FieldUse<'a> {
     pub cost_ratio: f32,
 }
 
+/// What a batch's traced rays teach later passes: the field's cell, and the moments that
+/// choose MIS's BSDF share (both `None`: nothing is recorded).
+#[derive(Default)]
+pub struct Lessons<'l, 'c> {
+    /// The gather's cell in the pass's field observations.
+    pub cell: Option<&'l mut CellRecorder<'c>>,
+    /// The pass's second moments per MIS share.
+    pub shares: Option<&'l mut ShareMoments>,
+}
+
 /// The running mean of earlier candidates' unoccluded values (value-aware acceptance).
 #[derive(Default)]
 struct RunningMean {
@@ -85,13 +96,13 @@ impl RunningMean {
 
 /// Runs one batch of `run.settings.rays` rays through `batch` (configured for those
 /// settings, or a variant of them) and returns its estimate of the reflected direct light.
-/// Every traced ray that could bring light is recorded in `recorder`, when given.
+/// Every traced ray that could bring light is recorded in `lessons`.
 pub fn run_batch<P: BatchProbe>(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
     counts: &mut RayCounts,
     probe: &mut P,
-    recorder: Option<&mut CellRecorder>,
+    mut lessons: Lessons,
 ) -> Vec3 {
     probe.started();
     batch.begin(run.settings.rays, run.seed, run.start);
@@ -104,11 +115,14 @@ pub fn run_batch<P: BatchProbe>(
     let values_unneeded = run.field.is_some() || !run.settings.acceptance.needs_value();
     let unwatched = !P::WATCHES && run.clock.is_none();
     if value_only && values_unneeded && unwatched && batch.decides_ahead() {
-        run_ahead(run, batch, counts, recorder);
+        run_ahead(run, batch, counts, &mut lessons);
     } else {
-        run_one_by_one(run, batch, counts, probe, recorder);
+        run_one_by_one(run, batch, counts, probe, &mut lessons);
     }
     let estimate = batch.finish();
+    if let Some(shares) = lessons.shares {
+        shares.end_gather();
+    }
     probe.finished(batch.config(), run.settings.rays, run.seed);
     Vec3::from(estimate.value)
 }
@@ -125,7 +139,7 @@ fn run_ahead(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
     counts: &mut RayCounts,
-    mut recorder: Option<&mut CellRecorder>,
+    lessons: &mut Lessons,
 ) {
     let mut drawn = [Toward::new(Vec3::ZERO); AHEAD];
     let mut blocked = [None; AHEAD];
@@ -140,7 +154,7 @@ fn run_ahead(
         for (toward, blocked) in drawn[..count].iter_mut().zip(&blocked) {
             let shadow_ray = radiance_if_free(run.world, run.at, toward, *blocked);
             let traced = value_of(run, *toward, shadow_ray);
-            record(batch, recorder.as_deref_mut(), toward.direction, &traced);
+            record(run, batch, lessons, toward, &traced);
         }
     }
 }
@@ -176,7 +190,7 @@ fn run_one_by_one<P: BatchProbe>(
     batch: &mut Batch<[f32; 3]>,
     counts: &mut RayCounts,
     probe: &mut P,
-    mut recorder: Option<&mut CellRecorder>,
+    lessons: &mut Lessons,
 ) {
     let at = run.at;
     let value_only = batch.map().is_none() && batch.observations().is_none();
@@ -187,9 +201,8 @@ fn run_one_by_one<P: BatchProbe>(
             batch.decide(at.frame.normal, false);
             continue;
         };
-        let direction = toward.direction;
         let in_support = at.carries(&toward);
-        probe.decided(direction, in_support);
+        probe.decided(toward.direction, in_support);
         let (decision, known) = decide(run, batch, &mut values, &mut toward, in_support);
         if let Decision::Trace { .. } = decision {
             let started = run.clock.map(|_| Instant::now());
@@ -198,7 +211,7 @@ fn run_one_by_one<P: BatchProbe>(
             } else {
                 trace(run, toward, known, counts)
             };
-            record(batch, recorder.as_deref_mut(), direction, &traced);
+            record(run, batch, lessons, &mut toward, &traced);
             if let (Some(clock), Some(started)) = (run.clock, started) {
                 clock.set(clock.get() + started.elapsed());
             }
@@ -207,18 +220,27 @@ fn run_one_by_one<P: BatchProbe>(
     }
 }
 
-/// Records a traced candidate toward `direction` in the batch, and in `recorder` whether
-/// its ray was free.
+/// Records a traced candidate toward `toward` in the batch, and what it teaches in
+/// `lessons`: whether its ray was free (in its direction's texel, and for the light it
+/// aimed at), and its value at every MIS share.
 fn record(
+    run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
-    recorder: Option<&mut CellRecorder>,
-    direction: Vec3,
+    lessons: &mut Lessons,
+    toward: &mut Toward,
     traced: &Traced,
 ) {
-    if let (Some(recorder), Some(free)) = (recorder, traced.free) {
-        recorder.record(direction.into(), free);
+    if let (Some(recorder), Some(free)) = (lessons.cell.as_deref_mut(), traced.free) {
+        recorder.record(toward.direction.into(), free);
         if let Some(source) = traced.source {
             recorder.record_source(source, free);
+        }
+    }
+    let value = luminance(traced.value);
+    if let (Some(shares), true) = (lessons.shares.as_deref_mut(), value > 0.0) {
+        let at = run.at;
+        if let Some(parts) = run.settings.strategy.mis_parts(at, toward) {
+            shares.add(value, parts, at.mis_bsdf_share);
         }
     }
     batch.record(traced.value.to_array(), traced.rating);

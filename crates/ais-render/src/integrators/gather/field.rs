@@ -2,8 +2,9 @@
 //! field learned in earlier passes, standing aside where roulette cannot pay, and what a
 //! pass gives back: its rays, and what a candidate and a traced ray cost in this render.
 
-use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse};
+use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse, Lessons};
 use super::guiding::CandidateSampler;
+use super::mis_share::ShareMoments;
 use super::race::{Race, RaceResult, TileMoments, RACE_PASSES};
 use super::strategy::{GatherPoint, Strategy};
 use super::{batch_for, GatherSettings, GatherTile, MapSource};
@@ -139,6 +140,8 @@ pub struct FieldPass {
     pub guided: [u64; 2],
     /// Its pixels' sample moments, in a race pass.
     pub moments: Option<TileMoments>,
+    /// Its gathers' second moments per MIS share.
+    pub shares: Option<ShareMoments>,
 }
 
 /// Where the field does not roll, it stands aside for the rest of the render (AIS off)
@@ -175,6 +178,10 @@ pub struct GatherLearning {
     race_guided: u64,
     /// Whether the field may stand aside (`field_race`).
     may_stand_aside: bool,
+    /// The pass's second moments per MIS share, merged from its tiles.
+    shares: ShareMoments,
+    /// The BSDF's share of MIS for the next pass, once learned.
+    mis_share: Option<f64>,
 }
 
 impl GatherLearning {
@@ -197,7 +204,16 @@ impl GatherLearning {
             race_result: None,
             race_guided: 0,
             may_stand_aside: settings.field_race,
+            shares: ShareMoments::default(),
+            mis_share: None,
         }
+    }
+
+    /// The BSDF's share of MIS for the next pass: learned from the last pass whose gathers
+    /// were enough to tell ([`ShareMoments::best`]); `None` before (the default,
+    /// [`MIS_BSDF_WEIGHT`](super::strategy::MIS_BSDF_WEIGHT)).
+    pub fn mis_share(&self) -> Option<f64> {
+        self.mis_share
     }
 
     /// Passes ended so far (the index of the pass about to run).
@@ -260,6 +276,9 @@ impl Learning for GatherLearning {
             if let Some(moments) = &pass.moments {
                 self.race.merge(moments);
             }
+            if let Some(shares) = &pass.shares {
+                self.shares.merge(shares);
+            }
         }
     }
 
@@ -270,6 +289,9 @@ impl Learning for GatherLearning {
         let field = Arc::make_mut(&mut self.field);
         field.merge_all(&std::mem::take(&mut self.pending));
         field.plan(cost_ratio);
+        if let Some(share) = std::mem::take(&mut self.shares).best() {
+            self.mis_share = Some(share);
+        }
         // The first pass reads an empty field: it guides nothing and says nothing.
         if self.passes > 0 && self.guided[1] > 0 {
             self.guided_share = Some(self.guided[0] as f64 / self.guided[1] as f64);
@@ -394,6 +416,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         probe,
         racing_off,
         raced_off,
+        shares,
         ..
     } = state;
     // A pixel racing as AIS off records its rays but is not guided (see `race`).
@@ -436,7 +459,11 @@ pub(super) fn field_gather<P: BatchProbe>(
         .as_mut()
         .filter(|_| record)
         .map(|observations| observations.cell_mut(site.key));
-    let value = run_batch(&run, batch, counts, probe, recorder.as_mut());
+    let lessons = Lessons {
+        cell: recorder.as_mut(),
+        shares: shares.as_mut(),
+    };
+    let value = run_batch(&run, batch, counts, probe, lessons);
     if let Some(started) = site.started {
         let after = batch.stats();
         cost.add(CostSample {

@@ -17,7 +17,7 @@
 //! observation map per learning gather, per thread.
 
 use super::acceptance::Acceptance;
-use super::batch_loop::{run_batch, BatchRun};
+use super::batch_loop::{run_batch, BatchRun, Lessons};
 use super::guiding::CandidateSampler;
 use super::settings::{GatherSettings, MapSource, MapUse, Update};
 use super::strategy::gather_point;
@@ -144,7 +144,7 @@ impl LearningPass {
             field: None,
             clock: None,
         };
-        run_batch(&run, batch, counts, &mut (), None);
+        run_batch(&run, batch, counts, &mut (), Lessons::default());
         let observations = batch
             .observations()
             .expect("learning gathers observe their rays");

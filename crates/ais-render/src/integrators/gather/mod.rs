@@ -20,12 +20,13 @@ pub mod field_guide;
 pub mod guiding;
 pub mod learning_pass;
 mod light;
+pub mod mis_share;
 pub mod race;
 pub mod settings;
 pub mod strategy;
 
 pub use acceptance::Acceptance;
-pub use batch_loop::{run_batch, BatchProbe, BatchRun};
+pub use batch_loop::{run_batch, BatchProbe, BatchRun, Lessons};
 pub use field::{field_has_use, field_passes, CostSample, FieldPass, GatherLearning};
 pub use light::arriving_light;
 pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing, Update};
@@ -42,6 +43,7 @@ use field_guide::FieldGuides;
 use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
+use mis_share::ShareMoments;
 use race::{RaceResult, TileMoments};
 use std::sync::Arc;
 
@@ -70,6 +72,9 @@ pub struct GatherStats {
     pub field_race: Option<RaceResult>,
     /// Whether the field stood aside for the last pass (it gathered as AIS off).
     pub field_stood_aside: bool,
+    /// The BSDF's share of MIS in the last pass, where the field's first passes learned it
+    /// (`None`: the default, [`strategy::MIS_BSDF_WEIGHT`]).
+    pub mis_share: Option<f64>,
 }
 
 impl TileStats for GatherStats {
@@ -84,6 +89,8 @@ impl TileStats for GatherStats {
         self.field_cost_ratio = self.field_cost_ratio.max(other.field_cost_ratio);
         self.field_race = self.field_race.or(other.field_race);
         self.field_stood_aside |= other.field_stood_aside;
+        // Passes merge in order: the last pass's share stays.
+        self.mis_share = other.mis_share.or(self.mis_share);
     }
 }
 
@@ -131,6 +138,10 @@ pub struct GatherTile<P: BatchProbe = ()> {
     race_result: Option<RaceResult>,
     /// What watches the batches.
     pub probe: P,
+    /// The pass's second moments per MIS share, while the field learns with MIS.
+    shares: Option<ShareMoments>,
+    /// The BSDF's share of MIS in this pass, where the field learns it (`None`: the default).
+    mis_share: Option<f64>,
 }
 
 impl<P: BatchProbe> GatherTile<P> {
@@ -145,6 +156,8 @@ impl<P: BatchProbe> GatherTile<P> {
         probe: P,
     ) -> Self {
         let field = settings.map == MapSource::Field;
+        let learns_share =
+            field && settings.strategy == Strategy::Mis && field::field_has_use(world, settings);
         // Where the field rolls, the race is timed: not with a pinned cost ratio, whose
         // images are reproducible.
         let rolls = field::field_rolls(settings);
@@ -185,6 +198,8 @@ impl<P: BatchProbe> GatherTile<P> {
             stands_aside: learning.stands_aside(),
             race_result: learning.race_result(),
             probe,
+            shares: (learns_share && tile.learns).then(ShareMoments::default),
+            mis_share: learning.mis_share().filter(|_| learns_share),
         };
         if let (true, Sharing::LearningPass { stride }) = (settings.shares_maps(), settings.sharing)
         {
@@ -240,6 +255,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
                 moments.end_pixel();
                 moments
             }),
+            shares: self.shares.take(),
         })
     }
 
@@ -273,6 +289,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
             field_cost_ratio: self.cost_ratio,
             field_race: self.race_result,
             field_stood_aside: self.stands_aside,
+            mis_share: self.mis_share,
         }
     }
 }
@@ -374,7 +391,8 @@ pub fn gather<P: BatchProbe>(
     if world.lights.is_empty() {
         return emitted;
     }
-    let at = gather_point(world, &hit, -ray.direction);
+    let mut at = gather_point(world, &hit, -ray.direction);
+    at.mis_bsdf_share = state.mis_share.unwrap_or(strategy::MIS_BSDF_WEIGHT);
     let footprint = world.camera.footprint(hit.t, world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if field {
@@ -444,7 +462,7 @@ fn map_gather<P: BatchProbe>(
         field: None,
         clock: None,
     };
-    let value = run_batch(&run, batch, counts, &mut state.probe, None);
+    let value = run_batch(&run, batch, counts, &mut state.probe, Lessons::default());
     if sharing {
         let observations = batch
             .observations()

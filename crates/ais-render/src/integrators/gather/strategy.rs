@@ -46,7 +46,8 @@ impl Strategy {
     }
 }
 
-/// Probability of the BSDF component in the MIS mixture.
+/// Probability of the BSDF component in the MIS mixture, unless the gather learned another
+/// ([`GatherPoint::mis_bsdf_share`]).
 pub const MIS_BSDF_WEIGHT: f64 = 0.5;
 
 /// Where a gather happens.
@@ -63,6 +64,8 @@ pub struct GatherPoint<'a> {
     pub bsdf: HitBsdf<'a>,
     /// The scene's emitters.
     pub lights: &'a Lights,
+    /// The BSDF's share of the MIS mixture here ([`MIS_BSDF_WEIGHT`] unless learned).
+    pub mis_bsdf_share: f64,
 }
 
 /// The gather point where `hit` is seen from direction `wo` (pointing away from it).
@@ -83,6 +86,7 @@ pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a
         wo,
         bsdf,
         lights: &world.lights,
+        mis_bsdf_share: MIS_BSDF_WEIGHT,
     }
 }
 
@@ -148,7 +152,8 @@ impl Strategy {
             Strategy::Bsdf => at.bsdf.pdf(at.wo, direction),
             Strategy::Light => light(),
             Strategy::Mis => {
-                MIS_BSDF_WEIGHT * at.bsdf.pdf(at.wo, direction) + (1.0 - MIS_BSDF_WEIGHT) * light()
+                let share = at.mis_bsdf_share;
+                share * at.bsdf.pdf(at.wo, direction) + (1.0 - share) * light()
             }
         }
     }
@@ -164,7 +169,7 @@ impl Strategy {
             Strategy::Bsdf => at.sample_bsdf(u),
             Strategy::Light => at.lights.sample_toward(&at.receiver, u),
             Strategy::Mis => {
-                let w = MIS_BSDF_WEIGHT as f32;
+                let w = at.mis_bsdf_share as f32;
                 if u[0] < w {
                     at.sample_bsdf([u[0] / w, u[1]])
                 } else {
@@ -184,7 +189,7 @@ impl Strategy {
         let light = |toward: &mut Toward| at.lights.pdf_toward(&at.receiver, toward);
         if let Some(mass) = toward.specular {
             let share = match self.effective(at) {
-                Strategy::Mis => MIS_BSDF_WEIGHT,
+                Strategy::Mis => at.mis_bsdf_share,
                 _ => 1.0,
             };
             return share * mass.probability as f64;
@@ -195,11 +200,40 @@ impl Strategy {
             Strategy::Light => light(toward),
             // Toward a point, spot or directional light: a point mass of light sampling,
             // which the BSDF's density does not add to.
-            Strategy::Mis if toward.is_delta() => (1.0 - MIS_BSDF_WEIGHT) * light(toward),
+            Strategy::Mis if toward.is_delta() => (1.0 - at.mis_bsdf_share) * light(toward),
             Strategy::Mis => {
-                MIS_BSDF_WEIGHT * at.bsdf.pdf(at.wo, toward.direction)
-                    + (1.0 - MIS_BSDF_WEIGHT) * light(toward)
+                let parts = self.mis_parts(at, toward).unwrap_or_default();
+                parts.mixed(at.mis_bsdf_share)
             }
         }
+    }
+
+    /// The two densities MIS mixes at a candidate drawn from a continuous density (not a
+    /// specular lobe or a delta light): BSDF sampling's and light sampling's, the latter of
+    /// what the direction meets first. `None` for other strategies and candidates.
+    #[inline]
+    pub fn mis_parts(self, at: &GatherPoint, toward: &mut Toward) -> Option<MisParts> {
+        let continuous = toward.specular.is_none() && !toward.is_delta();
+        (self.effective(at) == Strategy::Mis && continuous).then(|| MisParts {
+            bsdf: at.bsdf.pdf(at.wo, toward.direction),
+            light: at.lights.pdf_toward(&at.receiver, toward),
+        })
+    }
+}
+
+/// The densities that MIS mixes at one direction ([`Strategy::mis_parts`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MisParts {
+    /// BSDF sampling's density.
+    pub bsdf: f64,
+    /// Light sampling's density.
+    pub light: f64,
+}
+
+impl MisParts {
+    /// The mixture's density with the BSDF's share `share`.
+    #[inline]
+    pub fn mixed(self, share: f64) -> f64 {
+        share * self.bsdf + (1.0 - share) * self.light
     }
 }
