@@ -156,11 +156,16 @@ impl<P: BatchProbe> GatherTile<P> {
         probe: P,
     ) -> Self {
         let field = settings.map == MapSource::Field;
-        let learns_share =
-            field && settings.strategy == Strategy::Mis && field::field_has_use(world, settings);
         // Where the field rolls, the race is timed: not with a pinned cost ratio, whose
         // images are reproducible.
         let rolls = field::field_rolls(settings);
+        // Where the field rolls (64 candidates or more), a share that lowers the variance
+        // per candidate also changes what roulette skips and what a candidate costs: there
+        // a learned share lost in the rooms, and MIS keeps its default.
+        let learns_share = field
+            && settings.strategy == Strategy::Mis
+            && field::field_has_use(world, settings)
+            && !rolls;
         let races = field
             && settings.field_race
             && tile.learns
