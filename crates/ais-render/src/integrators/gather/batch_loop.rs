@@ -6,7 +6,7 @@ use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
 use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
-use super::strategy::GatherPoint;
+use super::strategy::{GatherPoint, MisParts};
 use crate::lights::{luminance, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
@@ -237,11 +237,10 @@ fn record(
         }
     }
     let value = luminance(traced.value);
-    if let (Some(shares), true) = (lessons.shares.as_deref_mut(), value > 0.0) {
-        let at = run.at;
-        if let Some(parts) = run.settings.strategy.mis_parts(at, toward) {
-            shares.add(value, parts, at.mis_bsdf_share);
-        }
+    if let (Some(shares), Some(parts), true) =
+        (lessons.shares.as_deref_mut(), traced.parts, value > 0.0)
+    {
+        shares.add(value, parts, run.at.mis_bsdf_share);
     }
     batch.record(traced.value.to_array(), traced.rating);
 }
@@ -323,6 +322,9 @@ struct Traced {
     free: Option<bool>,
     /// The light it aimed at, indexed as light sampling chooses them (None: none).
     source: Option<usize>,
+    /// MIS's two densities at it, where it brought light and the plain MIS proposal drew it
+    /// from a density (for [`ShareMoments`]).
+    parts: Option<MisParts>,
 }
 
 /// Traces an accepted candidate whose value alone is wanted (with whether its ray was
@@ -343,13 +345,19 @@ fn value_of(run: &BatchRun, mut toward: Toward, shadow_ray: ShadowRay) -> Traced
         rating: 0.0,
         free,
         source,
+        parts: None,
     };
     let radiance = match shadow_ray {
         ShadowRay::Unneeded => return nothing(None),
         ShadowRay::Blocked => return nothing(Some(false)),
         ShadowRay::Free(radiance) => radiance,
     };
-    let pdf = run.sampler.pdf(at, &mut toward);
+    // MIS's density from its two parts, kept for the share's moments.
+    let parts = run.sampler.mis_parts(at, &mut toward);
+    let pdf = match parts {
+        Some(parts) => parts.mixed(at.mis_bsdf_share),
+        None => run.sampler.pdf(at, &mut toward),
+    };
     // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 || radiance == Vec3::ZERO {
         return nothing(None);
@@ -359,6 +367,7 @@ fn value_of(run: &BatchRun, mut toward: Toward, shadow_ray: ShadowRay) -> Traced
         rating: 0.0,
         free: Some(true),
         source,
+        parts,
     }
 }
 
@@ -384,6 +393,7 @@ fn trace(
             rating: rating(0.0, 0.0),
             free: None,
             source: None,
+            parts: None,
         };
     }
     let actual = leaving.trace(run.world, counts);
@@ -394,5 +404,6 @@ fn trace(
         // A ray was traced toward light only if it could bring some.
         free: (leaving.unoccluded != Vec3::ZERO).then_some(rating > 0.0),
         source: run.world.lights.source_of(&toward),
+        parts: None,
     }
 }

@@ -16,7 +16,7 @@
 //! Both keep a share of the unguided density everywhere, so the estimate is exactly
 //! unbiased whatever the map says, and a wrong map costs at most `1 / (1 − α)` in variance.
 
-use super::strategy::{GatherPoint, Strategy};
+use super::strategy::{GatherPoint, MisParts, Strategy};
 use crate::lights::{Environment, EnvironmentGuide, Toward};
 use ais::mapping::LatLong;
 use ais::{AffinityMap, TexelDistribution};
@@ -69,6 +69,16 @@ impl<'a> CandidateSampler<'a> {
         } else {
             let rescaled = ((u[0] - alpha) / (1.0 - alpha)).min(1.0 - 1e-7);
             self.strategy.sample_direction(at, [rescaled, u[1]])
+        }
+    }
+
+    /// MIS's two densities at `toward` when this is the plain MIS proposal and a density
+    /// drew it ([`Strategy::mis_parts`]); `None` for a guided mixture.
+    #[inline]
+    pub fn mis_parts(&self, at: &GatherPoint, toward: &mut Toward) -> Option<MisParts> {
+        match self.guide {
+            None => self.strategy.mis_parts(at, toward),
+            Some(_) => None,
         }
     }
 
