@@ -163,6 +163,8 @@ fn run_ahead(
 /// returns how many were put in `drawn`.
 fn draw_ahead(run: &BatchRun, batch: &mut Batch<[f32; 3]>, drawn: &mut [Toward; AHEAD]) -> usize {
     let at = run.at;
+    // No value-aware rule runs here: the running mean stays unused.
+    let mut values = RunningMean::default();
     let mut count = 0;
     while count < AHEAD {
         let Some(candidate) = batch.next_candidate() else {
@@ -173,8 +175,6 @@ fn draw_ahead(run: &BatchRun, batch: &mut Batch<[f32; 3]>, drawn: &mut [Toward; 
             continue;
         };
         let in_support = at.carries(&toward);
-        // No value-aware rule runs here: the running mean stays unused.
-        let mut values = RunningMean::default();
         let (decision, _) = decide(run, batch, &mut values, &mut toward, in_support);
         if let Decision::Trace { .. } = decision {
             drawn[count] = toward;

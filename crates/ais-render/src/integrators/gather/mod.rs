@@ -162,14 +162,11 @@ impl<P: BatchProbe> GatherTile<P> {
         // Where the field rolls (64 candidates or more), a share that lowers the variance
         // per candidate also changes what roulette skips and what a candidate costs: there
         // a learned share lost in the rooms, and MIS keeps its default.
-        let learns_share = field
-            && settings.strategy == Strategy::Mis
-            && field::field_has_use(world, settings)
-            && !rolls;
-        let races = field
+        let has_use = field && field::field_has_use(world, settings);
+        let learns_share = has_use && settings.strategy == Strategy::Mis && !rolls;
+        let races = has_use
             && settings.field_race
             && tile.learns
-            && field::field_has_use(world, settings)
             && !(rolls && settings.cost_ratio.is_some())
             && race::RACE_PASSES.contains(&learning.passes_ended());
         let mut state = GatherTile {

@@ -151,10 +151,11 @@ impl Strategy {
             Strategy::Uniform => 1.0 / (4.0 * PI),
             Strategy::Bsdf => at.bsdf.pdf(at.wo, direction),
             Strategy::Light => light(),
-            Strategy::Mis => {
-                let share = at.mis_bsdf_share;
-                share * at.bsdf.pdf(at.wo, direction) + (1.0 - share) * light()
+            Strategy::Mis => MisParts {
+                bsdf: at.bsdf.pdf(at.wo, direction),
+                light: light(),
             }
+            .mixed(at.mis_bsdf_share),
         }
     }
 
@@ -201,10 +202,7 @@ impl Strategy {
             // Toward a point, spot or directional light: a point mass of light sampling,
             // which the BSDF's density does not add to.
             Strategy::Mis if toward.is_delta() => (1.0 - at.mis_bsdf_share) * light(toward),
-            Strategy::Mis => {
-                let parts = self.mis_parts(at, toward).unwrap_or_default();
-                parts.mixed(at.mis_bsdf_share)
-            }
+            Strategy::Mis => MisParts::toward(at, toward).mixed(at.mis_bsdf_share),
         }
     }
 
@@ -214,15 +212,12 @@ impl Strategy {
     #[inline]
     pub fn mis_parts(self, at: &GatherPoint, toward: &mut Toward) -> Option<MisParts> {
         let continuous = toward.specular.is_none() && !toward.is_delta();
-        (self.effective(at) == Strategy::Mis && continuous).then(|| MisParts {
-            bsdf: at.bsdf.pdf(at.wo, toward.direction),
-            light: at.lights.pdf_toward(&at.receiver, toward),
-        })
+        (self.effective(at) == Strategy::Mis && continuous).then(|| MisParts::toward(at, toward))
     }
 }
 
 /// The densities that MIS mixes at one direction ([`Strategy::mis_parts`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct MisParts {
     /// BSDF sampling's density.
     pub bsdf: f64,
@@ -231,6 +226,15 @@ pub struct MisParts {
 }
 
 impl MisParts {
+    /// The two densities at `toward`, light sampling's of what it meets first.
+    #[inline]
+    fn toward(at: &GatherPoint, toward: &mut Toward) -> Self {
+        MisParts {
+            bsdf: at.bsdf.pdf(at.wo, toward.direction),
+            light: at.lights.pdf_toward(&at.receiver, toward),
+        }
+    }
+
     /// The mixture's density with the BSDF's share `share`.
     #[inline]
     pub fn mixed(self, share: f64) -> f64 {
