@@ -76,6 +76,11 @@ pub struct GatherFlags {
     /// where it loses.
     #[arg(long)]
     field_race: Option<String>,
+    /// map field: "false" keeps --rays candidates in every gather; "true" (the default)
+    /// lets the race give fewer (down to n/8) to 16 × 16-pixel blocks whose noise is mostly
+    /// what the camera sees, for more camera samples in the same time.
+    #[arg(long)]
+    field_sizes: Option<String>,
     /// Mitsuba's hide_emitters: "true" hides the emitters the camera sees directly.
     #[arg(long)]
     hide_emitters: Option<String>,
@@ -103,6 +108,7 @@ impl GatherFlags {
             "field_cell" => &self.field_cell,
             "field_prior" => &self.field_prior,
             "field_race" => &self.field_race,
+            "field_sizes" => &self.field_sizes,
             "hide_emitters" => &self.hide_emitters,
             _ => &None,
         };

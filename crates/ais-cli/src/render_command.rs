@@ -409,4 +409,10 @@ fn print_gather_summary(
             }
         );
     }
+    if let Some(mean) = rendered.output.stats.gather_sizes {
+        println!(
+            "gather sizes {mean:.1} candidates per gather on average over the image's blocks after the race (fewer where the camera's noise dominates; {} asked)",
+            settings.rays
+        );
+    }
 }

@@ -245,17 +245,21 @@ fn the_learned_mis_share_is_thread_independent() {
 
 #[test]
 fn the_race_of_the_field_against_ais_off_is_reproducible() {
-    // 8 spp: passes of 1, 1, 2 and 4 samples; the second and third race the field against
-    // AIS off on a checkerboard of pixels, and the last follows the verdict. The race
-    // reads sample values only: same image at any thread count.
+    // 24 spp: passes of 1, 1, 2, 4 and 16 samples; the second and third race the field
+    // against AIS off on a checkerboard of pixels, and the rest follow the verdict, with
+    // the candidates per gather the race chose. The race reads sample values only: same
+    // image at any thread count.
     let world = interior(48, 27);
     let auto = Integrator::Gather(GatherSettings::default());
-    let one = on_threads_at(&world, 1, auto, 8);
-    let two = on_threads_at(&world, 2, auto, 8);
+    let one = on_threads_at(&world, 1, auto, 24);
+    let two = on_threads_at(&world, 2, auto, 24);
     assert_eq!(bits(&one.image), bits(&two.image));
     let race = one.stats.field_race.expect("the default gather raced");
     assert_eq!(Some(race), two.stats.field_race);
     assert!(race.field > 0.0 && race.off > 0.0, "{race:?}");
+    // The race also chose the candidates per gather for the last pass.
+    assert!(one.stats.gather_sizes.is_some(), "gather sizes chosen");
+    assert_eq!(one.stats.gather_sizes, two.stats.gather_sizes);
 }
 
 #[test]
@@ -296,7 +300,10 @@ fn raced(world: &World, spread: impl Fn(usize, usize) -> f32) -> gather::GatherL
             moments: (pass > 0).then_some(moments),
             shares: None,
         }));
-        learning.end_pass();
+        learning.end_pass(ais_render::render::PassEnd {
+            done: 2 * (pass + 1),
+            left: Some(8),
+        });
     }
     learning
 }

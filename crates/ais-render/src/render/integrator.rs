@@ -27,14 +27,25 @@ pub trait Learning: Sync {
     /// Adds a tile's observations. The result must not depend on the order of tiles.
     fn merge(&mut self, observed: Self::Observed);
 
-    /// Called once a pass's observations are all merged, before the next pass starts.
-    fn end_pass(&mut self) {}
+    /// Called once a pass's observations are all merged, before the next pass starts;
+    /// `samples` says how many samples per pixel the render has taken and has left.
+    fn end_pass(&mut self, _samples: PassEnd) {}
 
     /// Whether more learning passes can pay (asked after [`Learning::end_pass`]); if not,
     /// the render's remaining samples run as one last pass.
     fn keeps_learning(&self) -> bool {
         true
     }
+}
+
+/// Where a render stands when a pass ends.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct PassEnd {
+    /// Samples per pixel taken so far by this render.
+    pub done: u32,
+    /// Samples per pixel it has left (`None` where later renders go on from what this one
+    /// learns: the end is not known).
+    pub left: Option<u32>,
 }
 
 impl Learning for () {

@@ -15,7 +15,7 @@ mod integrator;
 mod tile;
 
 pub use counts::RayCounts;
-pub use integrator::{Learning, SampleIntegrator, TileState, TileStats};
+pub use integrator::{Learning, PassEnd, SampleIntegrator, TileState, TileStats};
 pub use tile::{pixel_seed, tiles, PixelRect, Tile, TILE_SIZE};
 
 use crate::film::{Film, ReconstructionFilter};
@@ -190,7 +190,10 @@ fn render_passes<I: SampleIntegrator>(
         for result in results {
             learned.merge(output.add(result, samples, settings.samples_per_pixel));
         }
-        learned.end_pass();
+        learned.end_pass(PassEnd {
+            done: passes[..=index].iter().sum(),
+            left: (!learning_goes_on).then(|| passes[index + 1..].iter().sum()),
+        });
         if index + 2 < passes.len() && !learned.keeps_learning() {
             // Learning cannot pay: the remaining samples in one last pass.
             let rest = passes[index + 1..].iter().sum();

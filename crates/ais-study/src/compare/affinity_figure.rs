@@ -63,6 +63,7 @@ pub fn snapshots(
         at: &at,
         sampler: &CandidateSampler::plain(settings.strategy),
         seed,
+        rays: settings.rays,
         start: ais::MapStart::Empty,
         field: None,
         clock: None,

@@ -2,6 +2,7 @@
 //! driver, traced and recorded. The host loop of the `ais` library, written for this
 //! renderer.
 
+use super::gather_sizes::CandidateSpread;
 use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
 use super::mis_share::ShareMoments;
@@ -42,8 +43,12 @@ impl BatchProbe for () {
 pub struct BatchRun<'a> {
     /// The scene.
     pub world: &'a World,
-    /// The gather's settings (n, acceptance, how the map is used).
+    /// The gather's settings (acceptance, how the map is used).
     pub settings: &'a GatherSettings,
+    /// Its candidates (the settings' `rays`, or fewer where [`GatherSizes`] says so).
+    ///
+    /// [`GatherSizes`]: super::gather_sizes::GatherSizes
+    pub rays: u32,
     /// Where the gather happens.
     pub at: &'a GatherPoint<'a>,
     /// Where candidates come from.
@@ -67,14 +72,17 @@ pub struct FieldUse<'a> {
     pub cost_ratio: f32,
 }
 
-/// What a batch's traced rays teach later passes: the field's cell, and the moments that
-/// choose MIS's BSDF share (both `None`: nothing is recorded).
+/// What a batch's traced rays teach later passes: the field's cell, the moments that
+/// choose MIS's BSDF share, and the spread of the candidates that tells the gather's
+/// variance (all `None`: nothing is recorded).
 #[derive(Default)]
 pub struct Lessons<'l, 'c> {
     /// The gather's cell in the pass's field observations.
     pub cell: Option<&'l mut CellRecorder<'c>>,
     /// The pass's second moments per MIS share.
     pub shares: Option<&'l mut ShareMoments>,
+    /// The gather's candidates as its estimate weighs them.
+    pub spread: Option<&'l mut CandidateSpread>,
 }
 
 /// The running mean of earlier candidates' unoccluded values (value-aware acceptance).
@@ -94,7 +102,7 @@ impl RunningMean {
     }
 }
 
-/// Runs one batch of `run.settings.rays` rays through `batch` (configured for those
+/// Runs one batch of `run.rays` rays through `batch` (configured for those
 /// settings, or a variant of them) and returns its estimate of the reflected direct light.
 /// Every traced ray that could bring light is recorded in `lessons`.
 pub fn run_batch<P: BatchProbe>(
@@ -105,7 +113,7 @@ pub fn run_batch<P: BatchProbe>(
     mut lessons: Lessons,
 ) -> Vec3 {
     probe.started();
-    batch.begin(run.settings.rays, run.seed, run.start);
+    batch.begin(run.rays, run.seed, run.start);
     // Without a map or observations, nothing reads what a traced ray saw but its value and
     // (for a recorder) whether it was free: a blocked ray can skip the lookups its value
     // would need.
@@ -123,7 +131,10 @@ pub fn run_batch<P: BatchProbe>(
     if let Some(shares) = lessons.shares {
         shares.end_gather();
     }
-    probe.finished(batch.config(), run.settings.rays, run.seed);
+    if let Some(spread) = lessons.spread {
+        spread.end_gather(estimate.candidates);
+    }
+    probe.finished(batch.config(), run.rays, run.seed);
     Vec3::from(estimate.value)
 }
 
@@ -142,26 +153,32 @@ fn run_ahead(
     lessons: &mut Lessons,
 ) {
     let mut drawn = [Toward::new(Vec3::ZERO); AHEAD];
+    let mut weights = [1.0; AHEAD];
     let mut blocked = [None; AHEAD];
     loop {
-        let count = draw_ahead(run, batch, &mut drawn);
+        let count = draw_ahead(run, batch, &mut drawn, &mut weights);
         if count == 0 {
             return;
         }
         for (toward, blocked) in drawn[..count].iter_mut().zip(&mut blocked) {
             *blocked = trace_aimed(run.world, run.at, toward, counts);
         }
-        for (toward, blocked) in drawn[..count].iter_mut().zip(&blocked) {
+        for ((toward, blocked), &weight) in drawn[..count].iter_mut().zip(&blocked).zip(&weights) {
             let shadow_ray = radiance_if_free(run.world, run.at, toward, *blocked);
             let traced = value_of(run, *toward, shadow_ray);
-            record(run, batch, lessons, toward, &traced);
+            record(run, batch, lessons, toward, &traced, weight);
         }
     }
 }
 
 /// Draws and decides candidates until [`AHEAD`] are to be traced or the batch is complete;
-/// returns how many were put in `drawn`.
-fn draw_ahead(run: &BatchRun, batch: &mut Batch<[f32; 3]>, drawn: &mut [Toward; AHEAD]) -> usize {
+/// returns how many were put in `drawn`, with their weights (1 / acceptance) in `weights`.
+fn draw_ahead(
+    run: &BatchRun,
+    batch: &mut Batch<[f32; 3]>,
+    drawn: &mut [Toward; AHEAD],
+    weights: &mut [f32; AHEAD],
+) -> usize {
     let at = run.at;
     // No value-aware rule runs here: the running mean stays unused.
     let mut values = RunningMean::default();
@@ -176,8 +193,9 @@ fn draw_ahead(run: &BatchRun, batch: &mut Batch<[f32; 3]>, drawn: &mut [Toward; 
         };
         let in_support = at.carries(&toward);
         let (decision, _) = decide(run, batch, &mut values, &mut toward, in_support);
-        if let Decision::Trace { .. } = decision {
+        if let Decision::Trace { weight } = decision {
             drawn[count] = toward;
+            weights[count] = weight;
             count += 1;
         }
     }
@@ -204,14 +222,14 @@ fn run_one_by_one<P: BatchProbe>(
         let in_support = at.carries(&toward);
         probe.decided(toward.direction, in_support);
         let (decision, known) = decide(run, batch, &mut values, &mut toward, in_support);
-        if let Decision::Trace { .. } = decision {
+        if let Decision::Trace { weight } = decision {
             let started = run.clock.map(|_| Instant::now());
             let traced = if value_only && known.is_none() {
                 traced_value(run, toward, counts)
             } else {
                 trace(run, toward, known, counts)
             };
-            record(run, batch, lessons, &mut toward, &traced);
+            record(run, batch, lessons, &mut toward, &traced, weight);
             if let (Some(clock), Some(started)) = (run.clock, started) {
                 clock.set(clock.get() + started.elapsed());
             }
@@ -220,15 +238,17 @@ fn run_one_by_one<P: BatchProbe>(
     }
 }
 
-/// Records a traced candidate toward `toward` in the batch, and what it teaches in
-/// `lessons`: whether its ray was free (in its direction's texel, and for the light it
-/// aimed at), and its value at every MIS share.
+/// Records a traced candidate toward `toward` (weighed `weight` = 1 / acceptance) in the
+/// batch, and what it teaches in `lessons`: whether its ray was free (in its direction's
+/// texel, and for the light it aimed at), its value at every MIS share, and its weighted
+/// value for the gather's spread.
 fn record(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
     lessons: &mut Lessons,
     toward: &mut Toward,
     traced: &Traced,
+    weight: f32,
 ) {
     if let (Some(recorder), Some(free)) = (lessons.cell.as_deref_mut(), traced.free) {
         recorder.record(toward.direction.into(), free);
@@ -241,6 +261,9 @@ fn record(
         (lessons.shares.as_deref_mut(), traced.parts, value > 0.0)
     {
         shares.add(value, parts, run.at.mis_bsdf_share);
+    }
+    if let Some(spread) = lessons.spread.as_deref_mut() {
+        spread.add(value as f64 * weight as f64);
     }
     batch.record(traced.value.to_array(), traced.rating);
 }

@@ -3,13 +3,14 @@
 //! pass gives back: its rays, and what a candidate and a traced ray cost in this render.
 
 use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse, Lessons};
+use super::gather_sizes::GatherSizes;
 use super::guiding::CandidateSampler;
 use super::mis_share::ShareMoments;
 use super::race::{Race, RaceResult, TileMoments, RACE_PASSES};
 use super::strategy::{GatherPoint, Strategy};
 use super::{batch_for, GatherSettings, GatherTile, MapSource};
 use crate::geometry::Hit;
-use crate::render::{Learning, RayCounts};
+use crate::render::{Learning, PassEnd, RayCounts};
 use crate::world::World;
 use ais::field::{CellIndex, CellKey, FieldCell, FieldObservations, VisibilityField};
 use ais::MapStart;
@@ -182,6 +183,12 @@ pub struct GatherLearning {
     shares: ShareMoments,
     /// The BSDF's share of MIS for the next pass, once learned.
     mis_share: Option<f64>,
+    /// The settings' candidates per gather.
+    rays: u32,
+    /// Whether the race chooses candidates per block (`field_sizes`).
+    chooses_sizes: bool,
+    /// The candidates per gather per block, once the race chose them.
+    sizes: Option<Arc<GatherSizes>>,
 }
 
 impl GatherLearning {
@@ -206,7 +213,16 @@ impl GatherLearning {
             may_stand_aside: settings.field_race,
             shares: ShareMoments::default(),
             mis_share: None,
+            rays: settings.rays,
+            chooses_sizes: settings.field_sizes,
+            sizes: None,
         }
+    }
+
+    /// The candidates per gather per block of the image, once the race chose them (`None`:
+    /// the settings' `rays` everywhere).
+    pub fn gather_sizes(&self) -> Option<&Arc<GatherSizes>> {
+        self.sizes.as_ref()
     }
 
     /// The BSDF's share of MIS for the next pass: learned from the last pass whose gathers
@@ -262,6 +278,17 @@ impl GatherLearning {
             .or_else(|| self.cost.ratio())
             .unwrap_or(UNMEASURED_COST_RATIO)
     }
+
+    /// Chooses the candidates per gather per block from the race's winning arm (where
+    /// `field_sizes` allows).
+    fn choose_sizes(&mut self, samples: PassEnd) {
+        let Some(race) = self.race_result.filter(|_| self.chooses_sizes) else {
+            return;
+        };
+        let blocks = self.race.blocks(!race.field_pays());
+        let columns = GatherSizes::columns_for(self.race.width());
+        self.sizes = GatherSizes::choose(&blocks, columns, self.rays, samples).map(Arc::new);
+    }
 }
 
 impl Learning for GatherLearning {
@@ -283,7 +310,7 @@ impl Learning for GatherLearning {
     }
 
     /// Plans the next pass's roulette at its cost ratio: which cells it pays in.
-    fn end_pass(&mut self) {
+    fn end_pass(&mut self, samples: PassEnd) {
         let cost_ratio = self.cost_ratio();
         // The pass's tiles have dropped their handles: no copy is made.
         let field = Arc::make_mut(&mut self.field);
@@ -303,6 +330,7 @@ impl Learning for GatherLearning {
         if self.passes == *RACE_PASSES.end() {
             let guided = self.race_guided > 0;
             self.race_result = self.race.result().map(|race| RaceResult { guided, ..race });
+            self.choose_sizes(samples);
             self.race = Race::default(); // its image-sized sums are no longer needed
         }
         self.passes += 1;
@@ -417,6 +445,9 @@ pub(super) fn field_gather<P: BatchProbe>(
         racing_off,
         raced_off,
         shares,
+        rays,
+        spread,
+        race,
         ..
     } = state;
     // A pixel racing as AIS off records its rays but is not guided (see `race`).
@@ -449,6 +480,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         at: &at,
         sampler: &sampler,
         seed: site.seed,
+        rays: *rays,
         start: MapStart::Empty,
         field: rolling.map(|cell| FieldUse { cell, cost_ratio }),
         clock: timed.then_some(&clock),
@@ -462,8 +494,12 @@ pub(super) fn field_gather<P: BatchProbe>(
     let lessons = Lessons {
         cell: recorder.as_mut(),
         shares: shares.as_mut(),
+        spread: spread.as_mut(),
     };
     let value = run_batch(&run, batch, counts, probe, lessons);
+    if let (Some(race), Some(spread)) = (race.as_mut(), spread.as_mut()) {
+        race.gathered(spread.take_variance());
+    }
     if let Some(started) = site.started {
         let after = batch.stats();
         cost.add(CostSample {

@@ -140,6 +140,7 @@ impl LearningPass {
             at: &at,
             sampler: &CandidateSampler::plain(learning.strategy),
             seed: ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64,
+            rays: learning.rays,
             start: MapStart::Empty,
             field: None,
             clock: None,

@@ -17,6 +17,7 @@ pub mod acceptance;
 pub mod batch_loop;
 pub mod field;
 pub mod field_guide;
+pub mod gather_sizes;
 pub mod guiding;
 pub mod learning_pass;
 mod light;
@@ -40,6 +41,7 @@ use ais::rng::Pcg32;
 use ais::shared::{blend_neighbours, NeighbourSource, RecentGathers};
 use ais::{AffinityMap, Batch, MapStart};
 use field_guide::FieldGuides;
+use gather_sizes::{CandidateSpread, GatherSizes};
 use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
@@ -75,6 +77,9 @@ pub struct GatherStats {
     /// The BSDF's share of MIS in the last pass, where the field's first passes learned it
     /// (`None`: the default, [`strategy::MIS_BSDF_WEIGHT`]).
     pub mis_share: Option<f64>,
+    /// The mean candidates per gather over the image's blocks, where the race chose them
+    /// per block ([`gather_sizes`]; `None`: the settings' `rays` everywhere).
+    pub gather_sizes: Option<f64>,
 }
 
 impl TileStats for GatherStats {
@@ -91,6 +96,7 @@ impl TileStats for GatherStats {
         self.field_stood_aside |= other.field_stood_aside;
         // Passes merge in order: the last pass's share stays.
         self.mis_share = other.mis_share.or(self.mis_share);
+        self.gather_sizes = other.gather_sizes.or(self.gather_sizes);
     }
 }
 
@@ -142,6 +148,14 @@ pub struct GatherTile<P: BatchProbe = ()> {
     shares: Option<ShareMoments>,
     /// The BSDF's share of MIS in this pass, where the field learns it (`None`: the default).
     mis_share: Option<f64>,
+    /// The settings' candidates per gather.
+    settings_rays: u32,
+    /// The candidates per gather per block, where the race chose them.
+    sizes: Option<Arc<GatherSizes>>,
+    /// The current pixel's candidates per gather.
+    pub(super) rays: u32,
+    /// The current gather's candidates as its estimate weighs them, in a race pass.
+    pub(super) spread: Option<CandidateSpread>,
 }
 
 impl<P: BatchProbe> GatherTile<P> {
@@ -202,6 +216,10 @@ impl<P: BatchProbe> GatherTile<P> {
             probe,
             shares: (learns_share && tile.learns).then(ShareMoments::default),
             mis_share: learning.mis_share().filter(|_| learns_share),
+            settings_rays: settings.rays,
+            sizes: learning.gather_sizes().cloned(),
+            rays: settings.rays,
+            spread: races.then(CandidateSpread::default),
         };
         if let (true, Sharing::LearningPass { stride }) = (settings.shares_maps(), settings.sharing)
         {
@@ -262,6 +280,10 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
     }
 
     fn begin_pixel(&mut self, x: usize, y: usize) {
+        self.rays = self
+            .sizes
+            .as_ref()
+            .map_or(self.settings_rays, |sizes| sizes.at(x, y));
         self.racing_off = match self.race.as_mut() {
             Some(race) => {
                 race.begin_pixel(x, y);
@@ -292,6 +314,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
             field_race: self.race_result,
             field_stood_aside: self.stands_aside,
             mis_share: self.mis_share,
+            gather_sizes: self.sizes.as_ref().map(|sizes| sizes.mean()),
         }
     }
 }
@@ -460,6 +483,7 @@ fn map_gather<P: BatchProbe>(
         at: &at,
         sampler: &sampler,
         seed: site.seed,
+        rays: state.rays,
         start,
         field: None,
         clock: None,

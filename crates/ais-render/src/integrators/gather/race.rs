@@ -26,7 +26,8 @@
 //! off, with no field work at all. Choosing how later passes gather from what earlier
 //! passes saw keeps every pass unbiased.
 
-use crate::render::PixelRect;
+use super::gather_sizes::{BlockMoments, GatherSizes};
+use crate::render::{PixelRect, TILE_SIZE};
 use crate::texture::luminance;
 use glam::Vec3;
 use std::time::Instant;
@@ -79,6 +80,10 @@ pub struct PixelMoments {
     pub sum_squares: f64,
     /// Seconds spent on them (0 where the race is not timed).
     pub seconds: f64,
+    /// Of the samples, those whose camera ray gathered.
+    pub gathers: u32,
+    /// The sum of those gathers' variances (each estimated from its own candidates).
+    pub gather_variance: f64,
 }
 
 impl PixelMoments {
@@ -93,6 +98,8 @@ impl PixelMoments {
         self.sum += other.sum;
         self.sum_squares += other.sum_squares;
         self.seconds += other.seconds;
+        self.gathers += other.gathers;
+        self.gather_variance += other.gather_variance;
     }
 
     fn mean(&self) -> Option<f64> {
@@ -149,6 +156,16 @@ impl TileMoments {
         }
     }
 
+    /// The current pixel's camera ray gathered with this variance, estimated from the
+    /// gather's own candidates (`None`: too few to tell; the sample counts as not gathered).
+    pub fn gathered(&mut self, variance: Option<f64>) {
+        if let Some(variance) = variance.filter(|v| v.is_finite()) {
+            let pixel = &mut self.pixels[self.current];
+            pixel.gathers += 1;
+            pixel.gather_variance += variance;
+        }
+    }
+
     /// Adds a sample of the current pixel.
     pub fn sampled(&mut self, value: [f32; 3]) {
         let value = luminance(Vec3::from(value)) as f64;
@@ -157,6 +174,18 @@ impl TileMoments {
             self.pixels[self.current].add(value);
         }
     }
+}
+
+/// A pixel's per-sample variance, weighted as relMSE weighs it.
+struct WeightedPixel {
+    x: usize,
+    y: usize,
+    /// Whether it raced as AIS off.
+    races_off: bool,
+    /// 1 / (r² + 0.01), with r the mean of the pixels around.
+    weight: f64,
+    /// Its per-sample variance times `weight`.
+    variance: f64,
 }
 
 /// The race's evidence over the image, and its verdict.
@@ -213,6 +242,11 @@ impl Race {
         }
     }
 
+    /// The image's width in pixels.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
     /// Adds a tile's moments (allocating the image's on first use).
     pub fn merge(&mut self, tile: &TileMoments) {
         if self.pixels.is_empty() {
@@ -227,22 +261,11 @@ impl Race {
     /// pixels with two samples or more. The field's arm is taken to have guided
     /// ([`RaceResult::guided`]): a host whose field only rolled says so.
     pub fn result(&self) -> Option<RaceResult> {
-        let mut weighted = Vec::new(); // (races off, weighted variance) per pixel
-        for y in 0..self.height.min(self.pixels.len() / self.width.max(1)) {
-            for x in 0..self.width {
-                if let Some(variance) = self.pixels[y * self.width + x].variance() {
-                    let reference = self.neighbourhood_mean(x, y);
-                    weighted.push((races_off(x, y), variance / (reference * reference + 0.01)));
-                }
-            }
-        }
-        let cap = quantile(weighted.iter().map(|&(_, v)| v).collect(), CAP_QUANTILE);
-        // Where nearly every pixel is noiseless, capping would hide the rest.
-        let cap = if cap > 0.0 { cap } else { f64::INFINITY };
+        let (pixels, cap) = self.weighted_pixels();
         let mut sums = [[0.0f64; 2]; 2]; // [field, off] × [capped variance, pixels]
-        for (off, variance) in weighted {
-            let arm = &mut sums[usize::from(off)];
-            arm[0] += variance.min(cap);
+        for pixel in pixels {
+            let arm = &mut sums[usize::from(pixel.races_off)];
+            arm[0] += pixel.variance.min(cap);
             arm[1] += 1.0;
         }
         let [field, off] = sums;
@@ -252,6 +275,52 @@ impl Race {
             seconds_per_sample: self.seconds_per_sample(),
             guided: true,
         })
+    }
+
+    /// What one arm's pixels measured, summed per 16 × 16 block of the image (row by row):
+    /// their weighted variances as [`Race::result`] weighs and caps them, their gathers',
+    /// and how many of their samples gathered.
+    pub fn blocks(&self, off_arm: bool) -> Vec<BlockMoments> {
+        let columns = GatherSizes::columns_for(self.width);
+        let rows = self.height.div_ceil(TILE_SIZE);
+        let mut blocks = vec![BlockMoments::default(); columns * rows];
+        let (pixels, cap) = self.weighted_pixels();
+        for pixel in pixels.iter().filter(|p| p.races_off == off_arm) {
+            let moments = &self.pixels[pixel.y * self.width + pixel.x];
+            let samples = moments.count as f64;
+            let gather = pixel.weight * moments.gather_variance / samples;
+            blocks[GatherSizes::block_of(pixel.x, pixel.y, columns)].add_pixel(
+                pixel.variance.min(cap),
+                gather.min(cap),
+                moments.gathers as f64 / samples,
+            );
+        }
+        blocks
+    }
+
+    /// Every pixel with two samples or more, its variance weighted as relMSE weighs it,
+    /// and the cap on those variances (their [`CAP_QUANTILE`]).
+    fn weighted_pixels(&self) -> (Vec<WeightedPixel>, f64) {
+        let mut weighted = Vec::new();
+        for y in 0..self.height.min(self.pixels.len() / self.width.max(1)) {
+            for x in 0..self.width {
+                if let Some(variance) = self.pixels[y * self.width + x].variance() {
+                    let reference = self.neighbourhood_mean(x, y);
+                    let weight = 1.0 / (reference * reference + 0.01);
+                    weighted.push(WeightedPixel {
+                        x,
+                        y,
+                        races_off: races_off(x, y),
+                        weight,
+                        variance: variance * weight,
+                    });
+                }
+            }
+        }
+        let cap = quantile(weighted.iter().map(|p| p.variance).collect(), CAP_QUANTILE);
+        // Where nearly every pixel is noiseless, capping would hide the rest.
+        let cap = if cap > 0.0 { cap } else { f64::INFINITY };
+        (weighted, cap)
     }
 
     /// Each arm's seconds per sample, if its pixels were timed.

@@ -20,6 +20,7 @@
 //! | `field_cell` | float | 16 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
 //! | `field_race` | boolean | true | `map = field`: race the field against AIS off in the second and third passes and gather the rest as AIS off where it loses, or where it finds almost nothing to guide or roll; false keeps the field for the whole render (to study it) |
+//! | `field_sizes` | boolean | true | `map = field`, after a race: gathers in 16 × 16-pixel blocks whose noise is mostly what the camera sees (edges, a window seen directly) get fewer candidates, down to n/8, so that the same time buys more camera samples; false keeps `rays` everywhere |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
 //! | `cost_ratio` | float or `measured` | `measured` | `map = field` with roulette (64 or more candidates): ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass but the last unless given (give it to make such an image reproducible bit for bit; with fewer candidates nothing is timed) |
 //!
@@ -36,7 +37,7 @@ use crate::scene::{Plugin, Property};
 use ais::{BatchConfig, MapConfig, Mode, Stopping};
 
 /// The parameter names, in the order they apply (a preset before the settings it bundles).
-pub const PARAMETERS: [&str; 19] = [
+pub const PARAMETERS: [&str; 20] = [
     "strategy",
     "rays",
     "budget",
@@ -55,6 +56,7 @@ pub const PARAMETERS: [&str; 19] = [
     "field_cell",
     "field_prior",
     "field_race",
+    "field_sizes",
     "hide_emitters",
 ];
 
@@ -281,6 +283,9 @@ pub struct GatherSettings {
     /// `map = field`: whether the field races AIS off and may stand aside (see
     /// [`super::race`]); false keeps it for the whole render.
     pub field_race: bool,
+    /// `map = field`: whether the race also chooses the candidates per gather per block
+    /// of the image (see [`super::gather_sizes`]); false keeps `rays` everywhere.
+    pub field_sizes: bool,
     /// Mitsuba's `hide_emitters`: camera rays add no emission of the emitters they hit
     /// directly, and the environment seen directly is black.
     pub hide_emitters: bool,
@@ -313,6 +318,7 @@ impl Default for GatherSettings {
             field_cell: DEFAULT_FIELD_CELL,
             field_prior: ais::field::PRIOR_FREE,
             field_race: true,
+            field_sizes: true,
             hide_emitters: false,
         }
     }
@@ -481,6 +487,7 @@ impl GatherSettings {
             "guide_fraction" => self.guide_fraction = Some(number(value, "guide_fraction")?),
             "hide_emitters" => self.hide_emitters = boolean(value, "hide_emitters")?,
             "field_race" => self.field_race = boolean(value, "field_race")?,
+            "field_sizes" => self.field_sizes = boolean(value, "field_sizes")?,
             "field_res" => self.field_res = number(value, "field_res")?,
             "field_cell" => self.field_cell = number(value, "field_cell")?,
             "field_prior" => self.field_prior = number(value, "field_prior")?,
