@@ -12,7 +12,7 @@ the camera sees directly is black in every image).
 
 For each scene of scenes/ (names without .xml; `default` is the built-in scene), a reference is rendered once by ais with AIS
 off at 1024 spp and 16 rays (cached in target/field-study/). Then every configuration renders
-SEEDS times (default 8) at `--spp` 32 for n = 16 and 8 for n = 128, in one process, and the
+SEEDS times (default 8) at `--spp` 32 for n = 16 and 8 for n = 128 (SPP sets another), in one process, and the
 script prints per configuration the mean relMSE against the reference (relMSE = mean((x − r)²
 / (r² + 0.01))) with its standard error over seeds, the median render time (configurations
 run interleaved, seed by seed), and the
@@ -36,6 +36,7 @@ AIS = os.environ.get('AIS_BINARY', os.path.join(ROOT, 'target', 'release', 'ais'
 WORK = os.path.join(ROOT, 'target', 'field-study')
 # Flags for every render, the reference's included.
 FLAGS = os.environ.get('FLAGS', '').split()
+# Samples per pixel per n; SPP (an environment variable) sets one count for every n.
 SPP_FOR = {16: 32, 128: 8}
 
 
@@ -82,7 +83,8 @@ def main():
             for seed in range(seeds):
                 for config in configs:
                     out = os.path.join(WORK, f'{scene}-{config.split("+")[0]}.exr')
-                    image, seconds, counts[config] = render(scene, size, SPP_FOR[n], n, config, seed, out)
+                    spp = int(os.environ.get('SPP', SPP_FOR[n]))
+                    image, seconds, counts[config] = render(scene, size, spp, n, config, seed, out)
                     errors[config].append(rel_mse(image, reference))
                     times[config].append(seconds)
             rows = {config: (np.mean(errors[config]), np.std(errors[config]) / np.sqrt(seeds),
