@@ -279,6 +279,24 @@ fn with_a_pinned_cost_ratio_the_rolling_field_does_not_race() {
     assert_eq!(bits(&one.image), bits(&two.image));
 }
 
+#[test]
+fn candidates_per_block_are_chosen_alike_at_any_thread_count_without_a_field() {
+    // A room lit by a rectangle light through a door gap: the field has no use at 16
+    // candidates, yet the race passes measure the pixels and the rest gathers as AIS off
+    // with the candidates per block they chose, from sample values only.
+    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
+    let description = load_scene(&scenes.join("door_gap.xml"), &[]).unwrap();
+    let mut world = World::from_description(description).unwrap();
+    world.set_resolution((48, 32));
+    let auto = Integrator::Gather(GatherSettings::default());
+    let one = on_threads_at(&world, 1, auto, 24);
+    let two = on_threads_at(&world, 2, auto, 24);
+    assert!(one.stats.gather_sizes.is_some(), "gather sizes chosen");
+    assert_eq!(one.stats.gather_sizes, two.stats.gather_sizes);
+    assert_eq!(one.stats.field_race, None, "nothing raced");
+    assert_eq!(bits(&one.image), bits(&two.image));
+}
+
 /// A learning whose race passes saw every pixel's two samples at 1 ± `spread(x, y)`.
 fn raced(world: &World, spread: impl Fn(usize, usize) -> f32) -> gather::GatherLearning {
     use ais_render::integrators::gather::race::TileMoments;

@@ -78,7 +78,10 @@ impl SampleIntegrator for Integrator {
 
     fn passes(&self, world: &World, spp: u32) -> Vec<u32> {
         match self {
-            Integrator::Gather(settings) if gather::field_has_use(world, settings) => {
+            Integrator::Gather(settings)
+                if gather::field_has_use(world, settings)
+                    || gather::field::chooses_sizes(settings) =>
+            {
                 gather::field_passes(spp)
             }
             _ => vec![spp],

@@ -81,6 +81,24 @@ pub fn field_has_use(world: &World, settings: &GatherSettings) -> bool {
     settings.map == MapSource::Field && (field_rolls(settings) || guides)
 }
 
+/// Whether gathers with these settings measure their pixels in the race passes to choose
+/// the candidates per gather per block (`map = field` with `field_sizes`): where the field
+/// has a use and where it has none (area lights only), since what the camera sees can
+/// dominate the noise anywhere. Such renders run in passes ([`field_passes`]).
+pub fn chooses_sizes(settings: &GatherSettings) -> bool {
+    settings.map == MapSource::Field && settings.field_sizes
+}
+
+/// Whether gathers with these settings race the field against AIS off on the image (see
+/// [`super::race`]): where the field has a use and may stand aside, and not where it
+/// rolls with a pinned cost ratio (the race would be timed; such images are
+/// reproducible).
+pub fn races(world: &World, settings: &GatherSettings) -> bool {
+    field_has_use(world, settings)
+        && settings.field_race
+        && !(field_rolls(settings) && settings.cost_ratio.is_some())
+}
+
 /// Learning stops once fewer than this share of the rays fall in cells where roulette pays.
 pub const LEAST_ROLLING_SHARE: f32 = 0.05;
 
@@ -185,8 +203,10 @@ pub struct GatherLearning {
     mis_share: Option<f64>,
     /// The settings' candidates per gather.
     rays: u32,
-    /// Whether the race chooses candidates per block (`field_sizes`).
+    /// Whether the race passes choose candidates per block ([`chooses_sizes`]).
     chooses_sizes: bool,
+    /// Whether those passes race the field against AIS off ([`races`]).
+    races: bool,
     /// The candidates per gather per block, once the race chose them.
     sizes: Option<Arc<GatherSizes>>,
 }
@@ -214,7 +234,8 @@ impl GatherLearning {
             shares: ShareMoments::default(),
             mis_share: None,
             rays: settings.rays,
-            chooses_sizes: settings.field_sizes,
+            chooses_sizes: chooses_sizes(settings),
+            races: races(world, settings),
             sizes: None,
         }
     }
@@ -279,13 +300,14 @@ impl GatherLearning {
             .unwrap_or(UNMEASURED_COST_RATIO)
     }
 
-    /// Chooses the candidates per gather per block from the race's winning arm (where
-    /// `field_sizes` allows).
+    /// Chooses the candidates per gather per block (where `field_sizes` allows) from the
+    /// pixels of the arm that won the race, or of all pixels where nothing raced.
     fn choose_sizes(&mut self, samples: PassEnd) {
-        let Some(race) = self.race_result.filter(|_| self.chooses_sizes) else {
+        if !self.chooses_sizes {
             return;
-        };
-        let blocks = self.race.blocks(!race.field_pays());
+        }
+        let arm = self.race_result.map(|race| !race.field_pays());
+        let blocks = self.race.blocks(arm);
         let columns = GatherSizes::columns_for(self.race.width());
         self.sizes = GatherSizes::choose(&blocks, columns, self.rays, samples).map(Arc::new);
     }
@@ -329,7 +351,8 @@ impl Learning for GatherLearning {
         self.guided = [0; 2];
         if self.passes == *RACE_PASSES.end() {
             let guided = self.race_guided > 0;
-            self.race_result = self.race.result().map(|race| RaceResult { guided, ..race });
+            self.race_result = (self.race.result().filter(|_| self.races))
+                .map(|race| RaceResult { guided, ..race });
             self.choose_sizes(samples);
             self.race = Race::default(); // its image-sized sums are no longer needed
         }
@@ -341,6 +364,11 @@ impl Learning for GatherLearning {
     /// machine) or its roulette, with enough evidence, stands aside for nearly every ray
     /// (the talk's auto-disable): then the rest of the render is one pass.
     fn keeps_learning(&self) -> bool {
+        // The candidates per block are chosen from the race passes, run as passes of
+        // their own even where the field has stood aside or has no use.
+        if self.chooses_sizes && self.passes <= *RACE_PASSES.end() {
+            return true;
+        }
         if self.stands_aside() {
             return false;
         }

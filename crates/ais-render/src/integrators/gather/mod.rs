@@ -132,8 +132,11 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) cost: CostSample,
     /// Gathers run by this tile (to sample the timed ones).
     pub(super) gathers: u64,
-    /// The pixel moments of a race pass (see [`race`]).
+    /// The pixel moments of a race pass (see [`race`]), raced or only measured for the
+    /// candidates per block.
     pub(super) race: Option<TileMoments>,
+    /// Whether this pass races the field against AIS off.
+    races: bool,
     /// Whether the current pixel gathers as AIS off in a race pass.
     pub(super) racing_off: bool,
     /// Gathers that raced as AIS off in this pass.
@@ -178,11 +181,10 @@ impl<P: BatchProbe> GatherTile<P> {
         // a learned share lost in the rooms, and MIS keeps its default.
         let has_use = field && field::field_has_use(world, settings);
         let learns_share = has_use && settings.strategy == Strategy::Mis && !rolls;
-        let races = has_use
-            && settings.field_race
-            && tile.learns
-            && !(rolls && settings.cost_ratio.is_some())
-            && race::RACE_PASSES.contains(&learning.passes_ended());
+        let race_pass = tile.learns && race::RACE_PASSES.contains(&learning.passes_ended());
+        let races = race_pass && field::races(world, settings);
+        // The race passes measure the pixels for the candidates per block, raced or not.
+        let measures = races || (race_pass && field::chooses_sizes(settings));
         let mut state = GatherTile {
             batch: None,
             recent: RecentGathers::default(),
@@ -208,7 +210,8 @@ impl<P: BatchProbe> GatherTile<P> {
             cost_ratio: learning.cost_ratio(),
             cost: CostSample::default(),
             gathers: 0,
-            race: races.then(|| TileMoments::new(tile.rect, rolls)),
+            race: measures.then(|| TileMoments::new(tile.rect, races && rolls)),
+            races,
             racing_off: false,
             raced_off: 0,
             stands_aside: learning.stands_aside(),
@@ -219,7 +222,7 @@ impl<P: BatchProbe> GatherTile<P> {
             settings_rays: settings.rays,
             sizes: learning.gather_sizes().cloned(),
             rays: settings.rays,
-            spread: races.then(CandidateSpread::default),
+            spread: measures.then(CandidateSpread::default),
         };
         if let (true, Sharing::LearningPass { stride }) = (settings.shares_maps(), settings.sharing)
         {
@@ -287,7 +290,7 @@ impl<P: BatchProbe> TileState for GatherTile<P> {
         self.racing_off = match self.race.as_mut() {
             Some(race) => {
                 race.begin_pixel(x, y);
-                race::races_off(x, y)
+                self.races && race::races_off(x, y)
             }
             None => false,
         };
@@ -488,7 +491,14 @@ fn map_gather<P: BatchProbe>(
         field: None,
         clock: None,
     };
-    let value = run_batch(&run, batch, counts, &mut state.probe, Lessons::default());
+    let lessons = Lessons {
+        spread: state.spread.as_mut(),
+        ..Lessons::default()
+    };
+    let value = run_batch(&run, batch, counts, &mut state.probe, lessons);
+    if let (Some(race), Some(spread)) = (state.race.as_mut(), state.spread.as_mut()) {
+        race.gathered(spread.take_variance());
+    }
     if sharing {
         let observations = batch
             .observations()

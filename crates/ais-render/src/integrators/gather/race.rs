@@ -277,15 +277,19 @@ impl Race {
         })
     }
 
-    /// What one arm's pixels measured, summed per 16 × 16 block of the image (row by row):
-    /// their weighted variances as [`Race::result`] weighs and caps them, their gathers',
-    /// and how many of their samples gathered.
-    pub fn blocks(&self, off_arm: bool) -> Vec<BlockMoments> {
+    /// What the pixels measured (one arm's: AIS off's if `off_arm` is `Some(true)`, the
+    /// field's if `Some(false)`; all where nothing raced), summed per 16 × 16 block of the
+    /// image (row by row): their weighted variances as [`Race::result`] weighs and caps
+    /// them, their gathers', and how many of their samples gathered.
+    pub fn blocks(&self, off_arm: Option<bool>) -> Vec<BlockMoments> {
         let columns = GatherSizes::columns_for(self.width);
         let rows = self.height.div_ceil(TILE_SIZE);
         let mut blocks = vec![BlockMoments::default(); columns * rows];
         let (pixels, cap) = self.weighted_pixels();
-        for pixel in pixels.iter().filter(|p| p.races_off == off_arm) {
+        for pixel in pixels
+            .iter()
+            .filter(|p| off_arm.is_none_or(|off| p.races_off == off))
+        {
             let moments = &self.pixels[pixel.y * self.width + pixel.x];
             let samples = moments.count as f64;
             let gather = pixel.weight * moments.gather_variance / samples;
