@@ -77,7 +77,7 @@ pub struct GatherFlags {
     #[arg(long)]
     field_race: Option<String>,
     /// map field: "false" keeps --rays candidates in every gather; "true" (the default)
-    /// lets the race give fewer (down to n/8) to 16 × 16-pixel blocks whose noise is mostly
+    /// lets the race give fewer (down to n/8, at least 4) to 16 × 16-pixel blocks whose noise is mostly
     /// what the camera sees, for more camera samples in the same time.
     #[arg(long)]
     field_sizes: Option<String>,

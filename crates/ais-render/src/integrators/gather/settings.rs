@@ -20,7 +20,7 @@
 //! | `field_cell` | float | 16 | `map = field`: a cell's edge in pixel footprints at the gather point (rounded to a power of two in world units) |
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
 //! | `field_race` | boolean | true | `map = field`: race the field against AIS off in the second and third passes and gather the rest as AIS off where it loses, or where it finds almost nothing to guide or roll; false keeps the field for the whole render (to study it) |
-//! | `field_sizes` | boolean | true | `map = field`, after a race: gathers in 16 × 16-pixel blocks whose noise is mostly what the camera sees (edges, a window seen directly) get fewer candidates, down to n/8, so that the same time buys more camera samples; false keeps `rays` everywhere |
+//! | `field_sizes` | boolean | true | `map = field`: after the race passes (raced or not: also under area lights alone), gathers in 16 × 16-pixel blocks whose noise is mostly what the camera sees (edges, a window seen directly) get fewer candidates, down to n/8 (at least 4), so that the same time buys more camera samples; false keeps `rays` everywhere |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
 //! | `cost_ratio` | float or `measured` | `measured` | `map = field` with roulette (64 or more candidates): ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass but the last unless given (give it to make such an image reproducible bit for bit; with fewer candidates nothing is timed) |
 //!
