@@ -391,15 +391,7 @@ fn every_mode_is_unbiased_with_a_fixed_candidate_budget() {
 
 /// A shipped scene at 12 × 8 pixels.
 fn small_shipped_scene(name: &str) -> World {
-    shipped_scene_at(name, (12, 8))
-}
-
-/// A shipped scene at `size` pixels.
-fn shipped_scene_at(name: &str, size: (u32, u32)) -> World {
-    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
-    let mut world = World::from_description(load_scene(&scenes.join(name), &[]).unwrap()).unwrap();
-    world.set_resolution(size);
-    world
+    common::shipped_scene_at(name, (12, 8))
 }
 
 #[test]
@@ -443,7 +435,7 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
     assert_field_agrees_with_ais_off("interior.xml", gather);
     // In a courtyard at 32 × 20 pixels the first pass has gathers enough to choose MIS's
     // BSDF share, which the later passes then use.
-    let world = shipped_scene_at("courtyard.xml", (32, 20));
+    let world = common::shipped_scene_at("courtyard.xml", (32, 20));
     let learned = render(
         &world,
         &Integrator::Gather(gather),
@@ -468,7 +460,7 @@ fn gathers_with_the_sizes_the_race_chose_are_unbiased() {
     // not checked: with these rooms' heavy tails a few pixels reach 5 in 1536, sized or
     // not.)
     for scene in ["interior.xml", "door_gap.xml"] {
-        let world = shipped_scene_at(scene, (48, 32));
+        let world = common::shipped_scene_at(scene, (48, 32));
         let gather = GatherSettings {
             budget: RayBudget::Candidates,
             hide_emitters: true,

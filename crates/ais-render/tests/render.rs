@@ -166,11 +166,7 @@ fn crops_pasted_together_equal_the_whole_render() {
 
 /// scenes/interior.xml (a room lit through a window by a sky with a sun) at `width × height`.
 fn interior(width: u32, height: u32) -> World {
-    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
-    let mut world =
-        World::from_description(load_scene(&scenes.join("interior.xml"), &[]).unwrap()).unwrap();
-    world.set_resolution((width, height));
-    world
+    common::shipped_scene_at("interior.xml", (width, height))
 }
 
 #[test]
@@ -231,10 +227,7 @@ fn the_default_gather_guides_without_timing_and_is_reproducible() {
 fn the_learned_mis_share_is_thread_independent() {
     // A courtyard, where most gathers see the sky: the first pass has gathers enough to
     // choose MIS's BSDF share, summed in tile order.
-    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
-    let description = load_scene(&scenes.join("courtyard.xml"), &[]).unwrap();
-    let mut world = World::from_description(description).unwrap();
-    world.set_resolution((40, 24));
+    let world = common::shipped_scene_at("courtyard.xml", (40, 24));
     let auto = Integrator::Gather(GatherSettings::default());
     let one = on_threads(&world, 1, auto);
     let two = on_threads(&world, 2, auto);
@@ -284,10 +277,7 @@ fn candidates_per_block_are_chosen_alike_at_any_thread_count_without_a_field() {
     // A room lit by a rectangle light through a door gap: the field has no use at 16
     // candidates, yet the race passes measure the pixels and the rest gathers as AIS off
     // with the candidates per block they chose, from sample values only.
-    let scenes = common::shipped_scenes().expect("the shipped scenes' assets");
-    let description = load_scene(&scenes.join("door_gap.xml"), &[]).unwrap();
-    let mut world = World::from_description(description).unwrap();
-    world.set_resolution((48, 32));
+    let world = common::shipped_scene_at("door_gap.xml", (48, 32));
     let auto = Integrator::Gather(GatherSettings::default());
     let one = on_threads_at(&world, 1, auto, 24);
     let two = on_threads_at(&world, 2, auto, 24);

@@ -87,6 +87,14 @@ pub fn shipped_scenes() -> Result<PathBuf, String> {
     Ok(folder)
 }
 
+/// A shipped scene (`scenes/NAME`) at `size` pixels.
+pub fn shipped_scene_at(name: &str, size: (u32, u32)) -> World {
+    let scenes = shipped_scenes().expect("the shipped scenes' assets");
+    let mut world = World::from_description(load_scene(&scenes.join(name), &[]).unwrap()).unwrap();
+    world.set_resolution(size);
+    world
+}
+
 use ais_render::render::{render, RenderSettings, SampleIntegrator};
 use ais_render::scene::load_scene;
 use ais_render::world::World;
