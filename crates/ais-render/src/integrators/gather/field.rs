@@ -8,7 +8,7 @@ use super::guiding::CandidateSampler;
 use super::mis_share::ShareMoments;
 use super::race::{Race, RaceResult, TileMoments, RACE_PASSES};
 use super::strategy::{GatherPoint, Strategy};
-use super::{batch_for, GatherSettings, GatherTile, MapSource};
+use super::{batch_for, note_gather_variance, GatherSettings, GatherTile, MapSource};
 use crate::geometry::Hit;
 use crate::render::{Learning, PassEnd, RayCounts};
 use crate::world::World;
@@ -352,7 +352,7 @@ impl Learning for GatherLearning {
         self.guided = [0; 2];
         if self.passes == *RACE_PASSES.end() {
             let guided = self.race_guided > 0;
-            self.race_result = (self.race.result().filter(|_| self.races))
+            self.race_result = (self.races.then(|| self.race.result()).flatten())
                 .map(|race| RaceResult { guided, ..race });
             self.choose_sizes(samples);
             self.race = Race::default(); // its image-sized sums are no longer needed
@@ -526,9 +526,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         spread: spread.as_mut(),
     };
     let value = run_batch(&run, batch, counts, probe, lessons);
-    if let (Some(race), Some(spread)) = (race.as_mut(), spread.as_mut()) {
-        race.gathered(spread.take_variance());
-    }
+    note_gather_variance(race, spread);
     if let Some(started) = site.started {
         let after = batch.stats();
         cost.add(CostSample {

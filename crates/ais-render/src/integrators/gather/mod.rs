@@ -436,6 +436,17 @@ pub fn gather<P: BatchProbe>(
     emitted + map_gather(world, settings, &site, at, state, counts)
 }
 
+/// Hands the variance of the gather just run, from its candidates' `spread`, to the pixel
+/// moments of a race pass (`race`), where both are kept.
+pub(super) fn note_gather_variance(
+    race: &mut Option<TileMoments>,
+    spread: &mut Option<CandidateSpread>,
+) {
+    if let (Some(race), Some(spread)) = (race.as_mut(), spread.as_mut()) {
+        race.gathered(spread.take_variance());
+    }
+}
+
 /// Where a gather with the batch's own map (or none) happens.
 struct MapSite<'a> {
     /// The first hit.
@@ -496,9 +507,7 @@ fn map_gather<P: BatchProbe>(
         ..Lessons::default()
     };
     let value = run_batch(&run, batch, counts, &mut state.probe, lessons);
-    if let (Some(race), Some(spread)) = (state.race.as_mut(), state.spread.as_mut()) {
-        race.gathered(spread.take_variance());
-    }
+    note_gather_variance(&mut state.race, &mut state.spread);
     if sharing {
         let observations = batch
             .observations()
