@@ -8,7 +8,7 @@ mod common;
 use ais_render::integrators::gather::{GatherSettings, Preset, Strategy};
 use ais_render::integrators::Integrator;
 use ais_study::oracle::Oracle;
-use common::{agreement, pixel_statistics};
+use common::{agreement, pixel_statistics, reference_statistics};
 
 const STRATEGIES: [Strategy; 4] = [
     Strategy::Uniform,
@@ -54,7 +54,7 @@ fn the_oracle_agrees_with_the_reference_in_an_occluded_scene() {
         rays: 32,
         ..GatherSettings::preset(Preset::Off)
     };
-    let reference = pixel_statistics(&world, &Integrator::Gather(reference_settings), 64, 8);
+    let reference = reference_statistics(&world, &Integrator::Gather(reference_settings), 64, 8);
     for strategy in STRATEGIES {
         let statistics = pixel_statistics(&world, &oracle(strategy), 8, 48);
         if let Err(message) = agreement(&statistics, &reference) {

@@ -8,12 +8,16 @@
 //! the tiles observed into its [`Learning`], which the next pass reads; once the learning
 //! says more passes cannot pay ([`Learning::keeps_learning`]), the remaining samples run as
 //! one pass. Pass 0 seeds each pixel's generator as a one-pass render does; later passes mix
-//! their index into the seed.
+//! their index into the seed. Where a camera sample falls in its pixel and on the lens
+//! comes from the pixel's own stratified sequence ([`CameraSamples`]), which runs on across
+//! passes and does not depend on what the integrator draws.
 
+mod camera_samples;
 mod counts;
 mod integrator;
 mod tile;
 
+pub use camera_samples::CameraSamples;
 pub use counts::RayCounts;
 pub use integrator::{Learning, PassEnd, SampleIntegrator, TileState, TileStats};
 pub use tile::{pixel_seed, tiles, PixelRect, Tile, TILE_SIZE};
@@ -96,6 +100,8 @@ struct Pass {
     index: u64,
     /// Its samples per pixel.
     samples: u32,
+    /// The rank in the render of its first sample of each pixel.
+    first_sample: u32,
 }
 
 impl Pass {
@@ -172,6 +178,7 @@ fn render_passes<I: SampleIntegrator>(
         let pass = Pass {
             index: index as u64,
             samples,
+            first_sample: passes[..index].iter().sum(),
         };
         let results: Vec<_> = rects
             .par_iter()
@@ -293,16 +300,18 @@ fn render_tile<I: SampleIntegrator>(
     let mut work = Vec::with_capacity(tile.rect.area());
     for (x, y) in tile.rect.pixels() {
         let mut rng = Pcg32::new(pass.pixel_seed(tile.seed, x, y, width), 0);
+        let camera_samples = CameraSamples::new(pixel_seed(tile.seed, x, y, width));
         let work_before = state.work();
         state.begin_pixel(x, y);
         let mut sum = [0.0f64; 3];
-        for _ in 0..spp {
-            let position = [x as f32 + rng.next_f32(), y as f32 + rng.next_f32()];
+        for rank in pass.first_sample..pass.first_sample + spp {
+            let [dx, dy] = camera_samples.position(rank);
+            let position = [x as f32 + dx, y as f32 + dy];
             let (u, v) = (position[0] / width as f32, position[1] / height as f32);
             let ray = if world.camera.has_aperture() {
                 world
                     .camera
-                    .ray_through_lens(u, v, [rng.next_f32(), rng.next_f32()])
+                    .ray_through_lens(u, v, camera_samples.lens(rank))
             } else {
                 world.camera.ray(u, v)
             };
