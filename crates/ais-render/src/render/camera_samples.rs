@@ -30,18 +30,23 @@ impl CameraSamples {
 
     /// The offset within the pixel of its sample of rank `index`, in [0, 1)².
     pub fn position(&self, index: u32) -> [f32; 2] {
-        [self.sample(index, 0), self.sample(index, 1)]
+        self.pair(index, 0)
     }
 
     /// The point on the unit square of the lens of its sample of rank `index`.
     pub fn lens(&self, index: u32) -> [f32; 2] {
-        [self.sample(index, 2), self.sample(index, 3)]
+        self.pair(index, 2)
     }
 
-    fn sample(&self, index: u32, dimension: u32) -> f32 {
+    /// Dimensions `first` and `first + 1` of the sample of rank `index`.
+    fn pair(&self, index: u32, first: u32) -> [f32; 2] {
         let sequence = (index / SEQUENCE_LENGTH) as u64;
-        let seed = mix64(self.seed ^ sequence.wrapping_mul(0x9E37_79B9_7F4A_7C15));
-        sobol_burley::sample(index % SEQUENCE_LENGTH, dimension, seed as u32)
+        let seed = mix64(self.seed ^ sequence.wrapping_mul(0x9E37_79B9_7F4A_7C15)) as u32;
+        let rank = index % SEQUENCE_LENGTH;
+        [
+            sobol_burley::sample(rank, first, seed),
+            sobol_burley::sample(rank, first + 1, seed),
+        ]
     }
 }
 
