@@ -261,6 +261,7 @@ pub fn run(args: RenderArgs) -> Result<(), String> {
     let settings = RenderSettings {
         samples_per_pixel,
         seed: args.seed,
+        first_sample: 0,
         progress: !args.quiet && std::io::stderr().is_terminal(),
         crop,
     };

@@ -200,6 +200,7 @@ impl Scene {
         let settings = RenderSettings {
             samples_per_pixel,
             seed: options.seed,
+            first_sample: 0,
             progress: options.progress,
             crop,
         };

@@ -521,6 +521,7 @@ fn small_render_settings() -> RenderSettings {
     RenderSettings {
         samples_per_pixel: 8,
         seed: 1,
+        first_sample: 0,
         progress: false,
         crop: None,
     }

@@ -18,6 +18,7 @@ fn settings(spp: u32) -> RenderSettings {
     RenderSettings {
         samples_per_pixel: spp,
         seed: 5,
+        first_sample: 0,
         progress: false,
         crop: None,
     }

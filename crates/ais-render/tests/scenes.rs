@@ -36,6 +36,7 @@ fn shipped_scenes_load_and_render() {
             &RenderSettings {
                 samples_per_pixel: 1,
                 seed: 0,
+                first_sample: 0,
                 progress: false,
                 crop: None,
             },

@@ -7,8 +7,8 @@
 //! renders in passes ([`SampleIntegrator::passes`]): after each pass the loop merges what
 //! the tiles observed into its [`Learning`], which the next pass reads; once the learning
 //! says more passes cannot pay ([`Learning::keeps_learning`]), the remaining samples run as
-//! one pass. Pass 0 seeds each pixel's generator as a one-pass render does; later passes mix
-//! their index into the seed. Where a camera sample falls in its pixel and on the lens
+//! one pass. The samples from rank 0 seed each pixel's generator as a one-pass render does;
+//! a later pass mixes the rank of its first sample into the seed. Where a camera sample falls in its pixel and on the lens
 //! comes from the pixel's own stratified sequence ([`CameraSamples`]), which runs on across
 //! passes and does not depend on what the integrator draws.
 
@@ -37,6 +37,11 @@ pub struct RenderSettings {
     pub samples_per_pixel: u32,
     /// Base seed; each pixel derives its own from it.
     pub seed: u64,
+    /// The rank, in each pixel's camera sequence, of this render's first sample: 0 for a
+    /// render of its own. A render that continues earlier ones of the same seed (a
+    /// progressive study's passes) starts where they stopped: its camera samples stay
+    /// stratified with theirs, and its random numbers differ from theirs.
+    pub first_sample: u32,
     /// Show a progress bar on stderr (it also hides itself when stderr is not a terminal).
     pub progress: bool,
     /// Render only these pixels of the image (None: all of them). The image returned is the
@@ -96,8 +101,6 @@ struct TileResult<S, O> {
 /// One pass of a render.
 #[derive(Clone, Copy, Debug)]
 struct Pass {
-    /// Its index.
-    index: u64,
     /// Its samples per pixel.
     samples: u32,
     /// The rank in the render of its first sample of each pixel.
@@ -105,15 +108,16 @@ struct Pass {
 }
 
 impl Pass {
-    /// The seed of pixel (x, y)'s generator in this pass: the pixel's own in pass 0, mixed
-    /// with the pass index after it. (PCG streams of one seed are correlated, so passes
-    /// take new seeds rather than new streams.)
+    /// The seed of pixel (x, y)'s generator in this pass: the pixel's own for the samples
+    /// from rank 0, mixed with the rank of the pass's first sample after it. (PCG streams
+    /// of one seed are correlated, so passes take new seeds rather than new streams.)
     fn pixel_seed(self, seed: u64, x: usize, y: usize, width: usize) -> u64 {
         let own = pixel_seed(seed, x, y, width);
-        if self.index == 0 {
+        if self.first_sample == 0 {
             own
         } else {
-            ais::rng::mix64(own ^ self.index.wrapping_mul(0x9E37_79B9_7F4A_7C15))
+            let rank = self.first_sample as u64;
+            ais::rng::mix64(own ^ rank.wrapping_mul(0x9E37_79B9_7F4A_7C15))
         }
     }
 }
@@ -176,9 +180,8 @@ fn render_passes<I: SampleIntegrator>(
     while index < passes.len() {
         let samples = passes[index];
         let pass = Pass {
-            index: index as u64,
             samples,
-            first_sample: passes[..index].iter().sum(),
+            first_sample: settings.first_sample + passes[..index].iter().sum::<u32>(),
         };
         let results: Vec<_> = rects
             .par_iter()

@@ -268,6 +268,7 @@ fn statistics_from<I: SampleIntegrator>(
         let settings = RenderSettings {
             samples_per_pixel: spp,
             seed,
+            first_sample: 0,
             progress: false,
             crop: None,
         };

@@ -79,18 +79,19 @@ impl Configuration {
         self.technique == Technique::Oracle
     }
 
-    /// Renders one pass of `spp` samples per pixel with `seed`, from what the run's earlier
-    /// passes learned (`learned`: the visibility field of `ais auto`), adding to it.
+    /// Renders one pass of the `samples` of each pixel with `seed`, from what the run's
+    /// earlier passes learned (`learned`: the visibility field of `ais auto`), adding to it.
     pub fn render_pass(
         &self,
         world: &World,
-        spp: u32,
+        samples: SampleRange,
         seed: u64,
         learned: &mut GatherLearning,
     ) -> Pass {
         let settings = RenderSettings {
-            samples_per_pixel: spp,
+            samples_per_pixel: samples.count,
             seed,
+            first_sample: samples.first,
             progress: false,
             crop: None,
         };
@@ -270,6 +271,15 @@ pub fn mean_and_error(values: &[f64]) -> (f64, f64) {
     (mean, (variance / n).sqrt())
 }
 
+/// A pass's samples of each pixel: their ranks `first..first + count` in the run.
+#[derive(Clone, Copy, Debug)]
+pub struct SampleRange {
+    /// The rank of the first.
+    pub first: u32,
+    /// How many.
+    pub count: u32,
+}
+
 /// When a progressive run stops.
 #[derive(Clone, Copy, Debug)]
 enum Budget {
@@ -297,8 +307,12 @@ fn progressive(
     };
     let mut learned = GatherLearning::new(world, &configuration.settings);
     loop {
-        let pass_seed = mix64(seed ^ mix64(run.spp as u64 + 1));
-        let output = configuration.render_pass(world, pass_spp, pass_seed, &mut learned);
+        // One seed for the run: its passes continue each pixel's camera sequence.
+        let samples = SampleRange {
+            first: run.spp,
+            count: pass_spp,
+        };
+        let output = configuration.render_pass(world, samples, seed, &mut learned);
         for (s, p) in sum.iter_mut().zip(&output.image.pixels) {
             for c in 0..3 {
                 s[c] += p[c] as f64 * pass_spp as f64;

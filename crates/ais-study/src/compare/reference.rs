@@ -82,7 +82,8 @@ fn render_half(
             &Integrator::Gather(settings),
             &RenderSettings {
                 samples_per_pixel: chunk,
-                seed: seed + done as u64,
+                seed,
+                first_sample: done,
                 progress: false,
                 crop: None,
             },
