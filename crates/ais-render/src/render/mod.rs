@@ -8,9 +8,10 @@
 //! the tiles observed into its [`Learning`], which the next pass reads; once the learning
 //! says more passes cannot pay ([`Learning::keeps_learning`]), the remaining samples run as
 //! one pass. The samples from rank 0 seed each pixel's generator as a one-pass render does;
-//! a later pass mixes the rank of its first sample into the seed. Where a camera sample falls in its pixel and on the lens
-//! comes from the pixel's own stratified sequence ([`CameraSamples`]), which runs on across
-//! passes and does not depend on what the integrator draws.
+//! a later pass mixes the rank of its first sample into the seed. Where a camera sample
+//! falls in its pixel and on the lens comes from the pixel's own stratified sequence
+//! ([`CameraSamples`]), which runs on across passes and does not depend on what the
+//! integrator draws.
 
 mod camera_samples;
 mod counts;
@@ -108,11 +109,11 @@ struct Pass {
 }
 
 impl Pass {
-    /// The seed of pixel (x, y)'s generator in this pass: the pixel's own for the samples
-    /// from rank 0, mixed with the rank of the pass's first sample after it. (PCG streams
-    /// of one seed are correlated, so passes take new seeds rather than new streams.)
-    fn pixel_seed(self, seed: u64, x: usize, y: usize, width: usize) -> u64 {
-        let own = pixel_seed(seed, x, y, width);
+    /// The seed of a pixel's generator in this pass, from the pixel's `own` seed: that
+    /// seed for the samples from rank 0, mixed with the rank of the pass's first sample
+    /// after it. (PCG streams of one seed are correlated, so passes take new seeds rather
+    /// than new streams.)
+    fn generator_seed(self, own: u64) -> u64 {
         if self.first_sample == 0 {
             own
         } else {
@@ -302,8 +303,9 @@ fn render_tile<I: SampleIntegrator>(
         .then(|| Film::covering(tile.rect.grown(filter.margin(), tile.image)));
     let mut work = Vec::with_capacity(tile.rect.area());
     for (x, y) in tile.rect.pixels() {
-        let mut rng = Pcg32::new(pass.pixel_seed(tile.seed, x, y, width), 0);
-        let camera_samples = CameraSamples::new(pixel_seed(tile.seed, x, y, width));
+        let own = pixel_seed(tile.seed, x, y, width);
+        let mut rng = Pcg32::new(pass.generator_seed(own), 0);
+        let camera_samples = CameraSamples::new(own);
         let work_before = state.work();
         state.begin_pixel(x, y);
         let mut sum = [0.0f64; 3];
