@@ -17,7 +17,11 @@ script prints per configuration the mean relMSE against the reference (relMSE = 
 / (r² + 0.01))) with its standard error over seeds, the median render time (configurations
 run interleaved, seed by seed), and the
 efficiency ratio against the first configuration: (relMSE · time) of the first over that of
-the row, with its noise from the two relMSE standard errors. Configurations whose learning
+the row. Its noise (±, one standard error) has two parts, also printed apart: the relMSE
+ratio's, from the seeds' spread with the pairing of seeds counted (a configuration and the
+first see the same camera samples at one seed, so their errors are correlated), and the
+time ratio's, from the spread of the per-seed time ratios (renders of one seed run back to
+back). The efficiency's time factor is the geometric mean of those per-seed ratios. Configurations whose learning
 happens between passes (auto) render their spp in passes within one render here; `ais
 compare` keeps one field across its 1-spp passes instead.
 """
@@ -62,6 +66,28 @@ def rel_mse(image, reference):
     return float(np.mean((image - reference) ** 2 / (reference ** 2 + 0.01)))
 
 
+def paired_ratio(base, other):
+    """mean(base) / mean(other) over paired seeds, and the relative standard error of that
+    ratio (delta method, with the pairs' covariance)."""
+    base, other = np.asarray(base), np.asarray(other)
+    if len(base) < 2:
+        return base.mean() / other.mean(), float('nan')
+    b, o = base.mean(), other.mean()
+    covariance = np.cov(base, other)
+    variance = (covariance[0, 0] / b ** 2 + covariance[1, 1] / o ** 2
+                - 2 * covariance[0, 1] / (b * o)) / len(base)
+    return b / o, float(np.sqrt(max(variance, 0.0)))
+
+
+def paired_ratio_of_times(base, other):
+    """The geometric mean of base / other over paired seeds, and its relative standard
+    error."""
+    logs = np.log(np.asarray(base)) - np.log(np.asarray(other))
+    if len(logs) < 2:
+        return float(np.exp(logs.mean())), float('nan')
+    return float(np.exp(logs.mean())), float(logs.std(ddof=1) / np.sqrt(len(logs)))
+
+
 def main():
     size, scenes = sys.argv[1], sys.argv[2].split(',')
     configs = sys.argv[3].split(',') if len(sys.argv) > 3 else ['off', 'auto']
@@ -87,16 +113,20 @@ def main():
                     image, seconds, counts[config] = render(scene, size, spp, n, config, seed, out)
                     errors[config].append(rel_mse(image, reference))
                     times[config].append(seconds)
-            rows = {config: (np.mean(errors[config]), np.std(errors[config]) / np.sqrt(seeds),
-                             np.median(times[config]), counts[config]) for config in configs}
-            base_error, base_se, base_time, _ = rows[configs[0]]
+            base = configs[0]
             for config in configs:
-                error, se, seconds, counts = rows[config]
-                efficiency = base_error * base_time / (error * seconds)
-                noise = efficiency * np.hypot(se / error, base_se / base_error)
-                per_gather = f'traced {counts[0]}, rejected {counts[2]} per gather' if counts else ''
-                print(f'{scene:14s} n={n:3d} {config:6s} relMSE {error:.3e}±{se:.1e} time {seconds:.3f}s  '
-                      f'efficiency {efficiency:.2f}× ±{noise:.2f}  {per_gather}', flush=True)
+                error = np.mean(errors[config])
+                se = np.std(errors[config]) / np.sqrt(seeds)
+                error_gain, error_noise = paired_ratio(errors[base], errors[config])
+                time_gain, time_noise = paired_ratio_of_times(times[base], times[config])
+                efficiency = error_gain * time_gain
+                noise = efficiency * np.hypot(error_noise, time_noise)
+                per_gather = f'traced {counts[config][0]}, rejected {counts[config][2]} per gather' \
+                    if counts[config] else ''
+                print(f'{scene:14s} n={n:3d} {config:6s} relMSE {error:.3e}±{se:.1e} '
+                      f'time {np.median(times[config]):.3f}s  efficiency {efficiency:.2f}× ±{noise:.2f} '
+                      f'(relMSE ±{error_gain * error_noise:.2f}, time ±{time_gain * time_noise:.2f})  '
+                      f'{per_gather}', flush=True)
 
 
 if __name__ == '__main__':
