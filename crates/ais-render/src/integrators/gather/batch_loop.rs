@@ -152,7 +152,7 @@ fn run_ahead(
     counts: &mut RayCounts,
     lessons: &mut Lessons,
 ) {
-    let mut drawn = [Toward::new(Vec3::ZERO); AHEAD];
+    let mut drawn = [None; AHEAD];
     let mut weights = [1.0; AHEAD];
     let mut blocked = [None; AHEAD];
     loop {
@@ -160,12 +160,14 @@ fn run_ahead(
         if count == 0 {
             return;
         }
-        for (toward, blocked) in drawn[..count].iter_mut().zip(&mut blocked) {
+        // Every slot up to `count` holds a drawn candidate.
+        for (toward, blocked) in drawn[..count].iter_mut().flatten().zip(&mut blocked) {
             *blocked = trace_aimed(run.world, run.at, toward, counts);
         }
-        for ((toward, blocked), &weight) in drawn[..count].iter_mut().zip(&blocked).zip(&weights) {
+        let traced = drawn[..count].iter_mut().flatten().zip(&blocked);
+        for ((toward, blocked), &weight) in traced.zip(&weights) {
             let shadow_ray = radiance_if_free(run.world, run.at, toward, *blocked);
-            let traced = value_of(run, *toward, shadow_ray);
+            let traced = value_of(run, toward, shadow_ray);
             record(run, batch, lessons, toward, &traced, weight);
         }
     }
@@ -176,7 +178,7 @@ fn run_ahead(
 fn draw_ahead(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
-    drawn: &mut [Toward; AHEAD],
+    drawn: &mut [Option<Toward>; AHEAD],
     weights: &mut [f32; AHEAD],
 ) -> usize {
     let at = run.at;
@@ -187,14 +189,16 @@ fn draw_ahead(
         let Some(candidate) = batch.next_candidate() else {
             break;
         };
-        let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
+        // Drawn into its slot and decided there: a candidate is not copied on its way.
+        let slot = &mut drawn[count];
+        *slot = run.sampler.sample_direction(at, candidate.u);
+        let Some(toward) = slot else {
             batch.decide(at.frame.normal, false);
             continue;
         };
-        let in_support = at.carries(&toward);
-        let (decision, _) = decide(run, batch, &mut values, &mut toward, in_support);
+        let in_support = at.carries(toward);
+        let (decision, _) = decide(run, batch, &mut values, toward, in_support);
         if let Decision::Trace { weight } = decision {
-            drawn[count] = toward;
             weights[count] = weight;
             count += 1;
         }
@@ -356,13 +360,13 @@ struct Traced {
 /// as nothing reads it (the batch has no map to learn).
 fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> Traced {
     let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts);
-    value_of(run, toward, shadow_ray)
+    value_of(run, &mut toward, shadow_ray)
 }
 
 /// What an accepted candidate brings, once its shadow ray is known ([`traced_value`]).
-fn value_of(run: &BatchRun, mut toward: Toward, shadow_ray: ShadowRay) -> Traced {
+fn value_of(run: &BatchRun, toward: &mut Toward, shadow_ray: ShadowRay) -> Traced {
     let at = run.at;
-    let source = run.world.lights.source_of(&toward);
+    let source = run.world.lights.source_of(toward);
     let nothing = |free| Traced {
         value: Vec3::ZERO,
         rating: 0.0,
@@ -376,17 +380,17 @@ fn value_of(run: &BatchRun, mut toward: Toward, shadow_ray: ShadowRay) -> Traced
         ShadowRay::Free(radiance) => radiance,
     };
     // MIS's density from its two parts, kept for the share's moments.
-    let parts = run.sampler.mis_parts(at, &mut toward);
+    let parts = run.sampler.mis_parts(at, toward);
     let pdf = match parts {
         Some(parts) => parts.mixed(at.mis_bsdf_share),
-        None => run.sampler.pdf(at, &mut toward),
+        None => run.sampler.pdf(at, toward),
     };
     // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 || radiance == Vec3::ZERO {
         return nothing(None);
     }
     Traced {
-        value: at.scattering(&toward) * radiance / pdf as f32,
+        value: at.scattering(toward) * radiance / pdf as f32,
         rating: 0.0,
         free: Some(true),
         source,
