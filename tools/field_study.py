@@ -21,9 +21,9 @@ the row. Its noise (±, one standard error) has two parts, also printed apart: t
 ratio's, from the seeds' spread with the pairing of seeds counted (a configuration and the
 first see the same camera samples at one seed, so their errors are correlated), and the
 time ratio's, from the spread of the per-seed time ratios (renders of one seed run back to
-back). The efficiency's time factor is the geometric mean of those per-seed ratios. Configurations whose learning
-happens between passes (auto) render their spp in passes within one render here; `ais
-compare` keeps one field across its 1-spp passes instead.
+back). The efficiency's time factor is the geometric mean of those per-seed ratios.
+Configurations whose learning happens between passes (auto) render their spp in passes
+within one render here; `ais compare` keeps one field across its 1-spp passes instead.
 """
 import os
 import re
