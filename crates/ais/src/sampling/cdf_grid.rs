@@ -158,12 +158,25 @@ impl CdfGrid {
     /// [`CdfGrid::sample`], giving the cell as its row and column.
     #[inline]
     pub fn sample_row_column(&self, u: [f32; 2]) -> (usize, usize, [f32; 2]) {
-        let (row, left_y) = invert_guided(&self.rows, &self.row_guide, u[1] as f64);
+        let (row, left_y) = self.sample_row(u[1]);
+        let (column, left_x) = self.sample_column(row, u[0]);
+        (row, column, [left_x, left_y])
+    }
+
+    /// The first half of a draw: the row drawn from `u` and where `u` fell within its bin.
+    #[inline]
+    pub fn sample_row(&self, u: f32) -> (usize, f32) {
+        invert_guided(&self.rows, &self.row_guide, u as f64)
+    }
+
+    /// The second half of a draw: the column drawn from `u` within `row`, and where `u`
+    /// fell within its bin.
+    #[inline]
+    pub fn sample_column(&self, row: usize, u: f32) -> (usize, f32) {
         let start = row * (self.columns + 1);
         let row_cdf = &self.cells[start..start + self.columns + 1];
         let guide = &self.cell_guides[row * self.columns..(row + 1) * self.columns];
-        let (column, left_x) = invert_guided(row_cdf, guide, u[0] as f64);
-        (row, column, [left_x, left_y])
+        invert_guided(row_cdf, guide, u as f64)
     }
 }
 
