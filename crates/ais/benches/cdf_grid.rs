@@ -46,7 +46,7 @@ fn draws(c: &mut Criterion) {
             for u in &us {
                 // A zero that the core cannot know before the previous draw is done.
                 let shift = (previous & (1 << 40)) as f32;
-                previous = grid.sample([u[0] + shift, u[1]]).0;
+                previous = grid.sample([u[0] + shift, u[1] + shift]).0;
             }
             previous
         })
