@@ -18,7 +18,7 @@ pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout};
 pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
-pub use spherical_rectangle::Rectangle;
+pub use spherical_rectangle::{Rectangle, LEAST_F32_SOLID_ANGLE};
 pub use toward::Toward;
 use toward::{AreaPoint, Source};
 
