@@ -61,6 +61,8 @@ pub(crate) struct Spherical<R> {
     z0: R,
     b0: R,
     b1: R,
+    /// 1 − b0², worked out in f64.
+    one_minus_b0_squared: R,
     k: R,
     solid_angle: R,
 }
@@ -135,6 +137,7 @@ impl Spherical<f64> {
             y1: self.y1 as f32,
             z0: self.z0 as f32,
             b0: self.b0 as f32,
+            one_minus_b0_squared: self.one_minus_b0_squared as f32,
             b1: self.b1 as f32,
             k: self.k as f32,
             solid_angle: self.solid_angle as f32,
@@ -147,18 +150,20 @@ impl<R: Real> Spherical<R> {
     /// distance to the point drawn.
     #[inline]
     fn sample(&self, u: [f32; 2]) -> (Vec3, f32) {
-        let (zero, one) = (R::of(0.0), R::of(1.0));
+        let one = R::of(1.0);
         let au = R::of(u[0] as f64) * self.solid_angle + self.k;
         let (sin_au, cos_au) = au.sin_cos();
-        let fu = (cos_au * self.b0 - self.b1) / sin_au;
-        let cu = (one / (fu * fu + self.b0 * self.b0).sqrt())
-            .copysign(fu)
-            .clamp(-one, one);
-        let xu =
-            (-(cu * self.z0) / (one - cu * cu).max(R::of(1e-18)).sqrt()).clamp(self.x0, self.x1);
-        let distance = (xu * xu + self.z0 * self.z0).sqrt();
-        let h0 = self.y0 / (distance * distance + self.y0 * self.y0).sqrt();
-        let h1 = self.y1 / (distance * distance + self.y1 * self.y1).sqrt();
+        // The paper's x_u = −z0 c_u / √(1 − c_u²), with c_u = sign(f_u) / √(f_u² + b0²) and
+        // f_u = n / sin a_u, n = cos a_u · b0 − b1, is −z0 sign(n) sin a_u / √(n² − (1 −
+        // b0²) sin² a_u): one square root and one division in the chain where there were
+        // three of each.
+        let n = cos_au * self.b0 - self.b1;
+        let below = (n * n - self.one_minus_b0_squared * sin_au * sin_au).max(R::of(1e-30));
+        let xu = (-self.z0 * one.copysign(n) * sin_au / below.sqrt()).clamp(self.x0, self.x1);
+        let distance_squared = xu * xu + self.z0 * self.z0;
+        let distance = distance_squared.sqrt();
+        let h0 = self.y0 / (distance_squared + self.y0 * self.y0).sqrt();
+        let h1 = self.y1 / (distance_squared + self.y1 * self.y1).sqrt();
         let hv = h0 + R::of(u[1] as f64) * (h1 - h0);
         let hv2 = hv * hv;
         // (In f32, 1 − 1e-12 rounds to 1.)
@@ -167,13 +172,13 @@ impl<R: Real> Spherical<R> {
         } else {
             self.y1
         };
-        let offset: [R; 3] =
-            std::array::from_fn(|i| xu * self.x[i] + yv * self.y[i] + self.z0 * self.z[i]);
-        let length = (offset[0] * offset[0] + offset[1] * offset[1] + offset[2] * offset[2])
-            .max(zero)
-            .sqrt();
-        let direction = Vec3::from(offset.map(|c| (c / length).as_f32()));
-        (direction, length.as_f32())
+        // x, y and z are orthonormal: the offset's length needs no sum over its components.
+        let length = (distance_squared + yv * yv).sqrt();
+        let scale = one / length;
+        let direction: [f32; 3] = std::array::from_fn(|i| {
+            ((xu * self.x[i] + yv * self.y[i] + self.z0 * self.z[i]) * scale).as_f32()
+        });
+        (Vec3::from(direction), length.as_f32())
     }
 }
 
@@ -242,6 +247,7 @@ impl Rectangle {
             y1,
             z0,
             b0: n0.z,
+            one_minus_b0_squared: 1.0 - n0.z * n0.z,
             b1: n2.z,
             k,
             solid_angle,
