@@ -798,16 +798,20 @@ fn microfacet_bsdfs_do_not_create_energy() {
     }
 }
 
-fn solid_angle_rectangle() -> AreaLight {
-    let rectangle = Rectangle::new(
+/// A tilted 1.4 × 1.1 rectangle about a unit distance in front of the origin.
+fn tilted_rectangle() -> Rectangle {
+    Rectangle::new(
         Vec3::new(-0.5, -0.4, 1.0),
         Vec3::new(1.4, 0.0, 0.2),
         Vec3::new(0.0, 1.1, 0.0),
         false,
     )
-    .unwrap();
+    .unwrap()
+}
+
+fn solid_angle_rectangle() -> AreaLight {
     AreaLight {
-        shape: AreaShape::Rectangle(rectangle),
+        shape: AreaShape::Rectangle(tilted_rectangle()),
         radiance: Vec3::ONE,
         texture: None,
         shape_index: 0,
@@ -889,13 +893,7 @@ fn rectangle_hits_p_value(rectangle: &Rectangle, point: Vec3, samples: u32, seed
 #[test]
 fn small_and_grazing_rectangles_are_sampled_uniformly_over_their_solid_angle() {
     use ais_render::lights::LEAST_F32_SOLID_ANGLE;
-    let rectangle = Rectangle::new(
-        Vec3::new(-0.5, -0.4, 1.0),
-        Vec3::new(1.4, 0.0, 0.2),
-        Vec3::new(0.0, 1.1, 0.0),
-        false,
-    )
-    .unwrap();
+    let rectangle = tilted_rectangle();
     // Far enough for f32 just above its least solid angle, far enough for f64, seen at a
     // grazing angle from beside the rectangle's plane, and from close in front. (With f32
     // everywhere, this test passes at 5e-4 and 4e-5 sr and fails at 4e-6 sr.)
