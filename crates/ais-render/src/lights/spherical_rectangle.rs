@@ -50,7 +50,7 @@ enum Draws {
 /// The spherical rectangle in its local frame (`x`, `y` along the edges, `z` away from
 /// the point), in the precision `R` it is sampled in.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Spherical<R> {
+struct Spherical<R> {
     x: [R; 3],
     y: [R; 3],
     z: [R; 3],
@@ -68,7 +68,7 @@ pub(crate) struct Spherical<R> {
 }
 
 /// The arithmetic a draw needs, in f32 or f64.
-pub(crate) trait Real:
+trait Real:
     Copy
     + PartialOrd
     + std::ops::Add<Output = Self>
@@ -77,7 +77,9 @@ pub(crate) trait Real:
     + std::ops::Div<Output = Self>
     + std::ops::Neg<Output = Self>
 {
+    /// `value` in this precision.
     fn of(value: f64) -> Self;
+    /// This value in f32.
     fn as_f32(self) -> f32;
     fn sqrt(self) -> Self;
     fn sin_cos(self) -> (Self, Self);
