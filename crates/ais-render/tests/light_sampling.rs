@@ -251,13 +251,14 @@ fn real_hdri_from_npm_fits() {
     else {
         return;
     };
-    let js = std::fs::read_to_string(package.join("hdri/dawn.exr.js")).unwrap();
+    let js = std::fs::read_to_string(package.folder().join("hdri/dawn.exr.js")).unwrap();
     let start = js.find("base64,").expect("a data URL") + "base64,".len();
     let end = start + js[start..].find('\'').expect("the closing quote");
     let bytes = base64::engine::general_purpose::STANDARD
         .decode(&js[start..end])
         .expect("valid base64");
-    let path = common::scratch("hdri").join("dawn.exr");
+    let hdri = common::scratch("hdri");
+    let path = hdri.join("dawn.exr");
     std::fs::write(&path, bytes).unwrap();
     let loaded = read_image(&path).unwrap();
     assert_eq!((loaded.image.width, loaded.image.height), (512, 256));

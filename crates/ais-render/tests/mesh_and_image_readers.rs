@@ -7,10 +7,11 @@ use ais_render::image_io::{read_image, write_exr, RgbImage};
 use ais_render::mesh::load_mesh;
 use ais_render::scene::MeshFormat;
 use glam::Vec3;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ais-readers-{}", std::process::id()));
+    let dir =
+        Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("readers-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     dir.join(name)
 }

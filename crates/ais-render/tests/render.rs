@@ -451,7 +451,6 @@ fn path_elements_add_folders_to_search_for_files() {
         panic!("the mesh is not beside the scene");
     };
     assert!(error.to_string().contains("quad.obj"), "{error}");
-    std::fs::remove_dir_all(dir).unwrap();
 }
 
 #[test]
@@ -499,8 +498,9 @@ fn the_stanford_bunny_from_npm_loads_and_renders() {
     let Some(package) = npm_package("the npm bunny test", "bunny@1.0.1") else {
         return;
     };
-    let dir = package.parent().unwrap().to_path_buf();
-    let index = std::fs::read_to_string(package.join("index.js")).unwrap();
+    let folder = package.folder();
+    let dir = folder.parent().unwrap().to_path_buf();
+    let index = std::fs::read_to_string(folder.join("index.js")).unwrap();
     let obj = bunny_obj(&index).expect("the bunny package has positions and cells");
     std::fs::write(dir.join("bunny.obj"), obj).unwrap();
     let scene = write_scene(

@@ -2,14 +2,47 @@
 #![allow(dead_code)]
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// A fresh scratch folder for one test.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("ais-render-{}-{name}", std::process::id()));
+/// A scratch folder for one test, removed with all it holds when dropped (test runs must
+/// not fill the temporary folder: an npm package alone is 33 MB).
+pub struct Scratch(PathBuf);
+
+impl std::ops::Deref for Scratch {
+    type Target = Path;
+
+    fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+/// A fresh scratch folder for one test; keep it bound while its files are used.
+pub fn scratch(name: &str) -> Scratch {
+    // In the build's own temporary folder, so that even a panicking test leaves nothing
+    // outside the target folder.
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("ais-render-{}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir
+    Scratch(dir)
+}
+
+/// An npm package unpacked in a scratch folder (removed when dropped).
+pub struct NpmPackage {
+    scratch: Scratch,
+}
+
+impl NpmPackage {
+    /// The package's folder.
+    pub fn folder(&self) -> PathBuf {
+        self.scratch.join("package")
+    }
 }
 
 /// Prints why a test is skipped, where the test harness does not swallow it.
@@ -18,12 +51,12 @@ pub fn skip(test: &str, reason: &str) {
 }
 
 /// Fetches an npm package tarball (`name@version`) with `npm pack` and unpacks it; returns
-/// the package folder, or `None` (after printing why) when npm cannot provide it.
-pub fn npm_package(test: &str, spec: &str) -> Option<PathBuf> {
+/// the unpacked package, or `None` (after printing why) when npm cannot provide it.
+pub fn npm_package(test: &str, spec: &str) -> Option<NpmPackage> {
     let dir = scratch(&format!("npm-{}", spec.replace(['/', '@'], "_")));
     let pack = Command::new("npm")
         .args(["pack", spec, "--silent", "--pack-destination"])
-        .arg(&dir)
+        .arg(&*dir)
         .output();
     let tarball = match pack {
         Err(e) => {
@@ -49,11 +82,11 @@ pub fn npm_package(test: &str, spec: &str) -> Option<PathBuf> {
     };
     let untar = Command::new("tar")
         .args(["xzf", &tarball])
-        .current_dir(&dir)
+        .current_dir(&*dir)
         .status()
         .expect("tar runs");
     assert!(untar.success(), "the npm tarball {tarball} must unpack");
-    Some(dir.join("package"))
+    Some(NpmPackage { scratch: dir })
 }
 
 /// The repository's `scenes/` folder, with its generated assets made (by
