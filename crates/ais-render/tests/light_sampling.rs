@@ -843,6 +843,10 @@ fn spherical_rectangle_sampling_fits() {
 fn rectangle_hits_p_value(rectangle: &Rectangle, point: Vec3, samples: u32, seed: u64) -> f64 {
     let bins = 8usize;
     let solid_angle = rectangle.solid_angle(point);
+    let origin = point.as_dvec3();
+    let corner = rectangle.corner.as_dvec3();
+    let (edge_x, edge_y) = (rectangle.edge_x.as_dvec3(), rectangle.edge_y.as_dvec3());
+    let normal = rectangle.normal.as_dvec3();
     let mut observed = vec![0.0; bins * bins];
     let mut rng = Pcg32::new(seed, 1);
     for _ in 0..samples {
@@ -852,12 +856,10 @@ fn rectangle_hits_p_value(rectangle: &Rectangle, point: Vec3, samples: u32, seed
         assert!((pdf * solid_angle - 1.0).abs() < 1e-6);
         // Where the direction meets the rectangle's plane, in f64 (an f32 direction from
         // far away may miss the edge by a rounding).
-        let (origin, direction) = (point.as_dvec3(), direction.as_dvec3());
-        let normal = rectangle.normal.as_dvec3();
-        let corner = rectangle.corner.as_dvec3();
+        let direction = direction.as_dvec3();
         let t = (corner - origin).dot(normal) / direction.dot(normal);
         let local = origin + direction * t - corner;
-        let along = |edge: Vec3| local.dot(edge.as_dvec3()) / edge.as_dvec3().length_squared();
+        let along = |edge: glam::DVec3| local.dot(edge) / edge.length_squared();
         let bin = |f: f64| {
             assert!(
                 (-1e-4..=1.0 + 1e-4).contains(&f),
@@ -865,23 +867,22 @@ fn rectangle_hits_p_value(rectangle: &Rectangle, point: Vec3, samples: u32, seed
             );
             ((f.max(0.0) * bins as f64) as usize).min(bins - 1)
         };
-        observed[bin(along(rectangle.edge_y)) * bins + bin(along(rectangle.edge_x))] += 1.0;
+        observed[bin(along(edge_y)) * bins + bin(along(edge_x))] += 1.0;
     }
-    let steps = 16;
-    let cell_area = rectangle.area() / (bins * steps * bins * steps) as f64;
+    let steps = bins * 16; // midpoints per edge
+    let cell_area = rectangle.area() / (steps * steps) as f64;
     let expected: Vec<f64> = (0..bins * bins)
         .map(|index| {
             let (row, column) = (index / bins, index % bins);
             let mut share = 0.0;
-            for i in 0..steps {
-                for j in 0..steps {
-                    let fx = (column * steps + j) as f64 + 0.5;
-                    let fy = (row * steps + i) as f64 + 0.5;
-                    let at = rectangle.corner.as_dvec3()
-                        + rectangle.edge_x.as_dvec3() * (fx / (bins * steps) as f64)
-                        + rectangle.edge_y.as_dvec3() * (fy / (bins * steps) as f64);
-                    let offset = at - point.as_dvec3();
-                    let cosine = offset.normalize().dot(rectangle.normal.as_dvec3()).abs();
+            for i in row * 16..(row + 1) * 16 {
+                for j in column * 16..(column + 1) * 16 {
+                    let (fx, fy) = (
+                        (j as f64 + 0.5) / steps as f64,
+                        (i as f64 + 0.5) / steps as f64,
+                    );
+                    let offset = corner + edge_x * fx + edge_y * fy - origin;
+                    let cosine = offset.normalize().dot(normal).abs();
                     share += cosine / offset.length_squared() * cell_area / solid_angle;
                 }
             }
