@@ -410,7 +410,7 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
     // The field learned in each render's first passes rolls the later ones' candidates,
     // guides their environment draws, or both, through a window: every pixel agrees with
     // AIS off. The interior's sky is an environment map; the overcast room's a constant.
-    // Among several lights, it guides the choice of a light.
+    // Among several lights, it guides the choice of a light by what each brought.
     let cases = [
         ("interior.xml", Strategy::Mis, MapUse::Roulette, true),
         ("interior.xml", Strategy::Mis, MapUse::Proposal, true),
@@ -422,6 +422,9 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
         // pays almost nowhere there, so the field would stand aside after its first pass:
         // kept (`field_race` false) to test its choice.
         ("sphere_lights.xml", Strategy::Light, MapUse::Both, false),
+        // A sky with a sun and a lamp under a roof: the cells under it choose the lamp by
+        // what it brought them, far above its share of the power.
+        ("occluded.xml", Strategy::Mis, MapUse::Proposal, false),
     ];
     for (scene, strategy, map_use, field_race) in cases {
         // At 12 × 8 pixels the default cells (16 footprints) would span the image, and

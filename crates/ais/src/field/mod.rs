@@ -20,7 +20,10 @@
 //!
 //! A cell may also count rays by *source*: whatever the host says a ray aimed at (one of
 //! its emitters, say), so that it can learn which sources a cell sees
-//! ([`VisibilityField::with_sources`], [`FieldCell::source_visibility`]).
+//! ([`VisibilityField::with_sources`], [`FieldCell::source_visibility`]), and what the rays
+//! that reached each source brought, as the host's estimate weighs them
+//! ([`CellRecorder::record_brought`], [`FieldCell::source_brought`]): which sources light
+//! the cell, not only which it sees.
 
 pub mod octahedral;
 pub mod pooling;
@@ -149,6 +152,9 @@ pub struct VisibilityField {
     cells: KeyMap<u32>,
     /// Per cell, its texels' counts, then its sources'.
     counts: Vec<TexelCounts>,
+    /// Per cell, what the rays that reached each source brought (summed in the order the
+    /// host merges its observations, so the same at any thread count).
+    brought: Vec<f64>,
     /// Per cell, the sum of its texels' counts.
     totals: Vec<TexelCounts>,
     /// Per cell, its texels' visibilities pooled with their blocks' ([`pooling`]).
@@ -182,6 +188,7 @@ impl VisibilityField {
             prior: PRIOR_FREE,
             cells: KeyMap::default(),
             counts: Vec::new(),
+            brought: Vec::new(),
             totals: Vec::new(),
             pooled: Vec::new(),
             darkest: Vec::new(),
@@ -241,6 +248,7 @@ impl VisibilityField {
                 + self.darkest.capacity()
                 + self.expected_rejection.capacity())
                 * std::mem::size_of::<f32>()
+            + self.brought.capacity() * std::mem::size_of::<f64>()
     }
 
     /// Works out, for every cell, the share of its candidates that roulette at `cost_ratio`
@@ -303,10 +311,12 @@ impl VisibilityField {
     pub fn cell_at(&self, CellIndex(first): CellIndex) -> FieldCell<'_> {
         let (texels, first) = ((self.side * self.side) as usize, first as usize);
         let index = first / self.stride();
+        let sources = self.sources as usize;
         FieldCell {
             counts: &self.counts[first..first + texels],
             pooled: &self.pooled[index * texels..(index + 1) * texels],
             sources: &self.counts[first + texels..first + self.stride()],
+            brought: &self.brought[index * sources..(index + 1) * sources],
             total: self.totals[index],
             darkest: self.darkest[index],
             planned: self
@@ -349,22 +359,28 @@ impl VisibilityField {
     }
 
     /// Adds `seen` to the counts of cell `key` (made if new); returns its index.
-    fn add(&mut self, key: CellKey, seen: &[TexelCounts]) -> usize {
+    fn add(&mut self, key: CellKey, seen: &CellSeen) -> usize {
         let (texels, stride) = ((self.side * self.side) as usize, self.stride());
         let next = self.counts.len() as u32;
         let first = *self.cells.entry(key).or_insert_with(|| next) as usize;
         if first == next as usize {
             self.counts.resize(first + stride, TexelCounts::default());
+            self.brought
+                .resize(self.brought.len() + self.sources as usize, 0.0);
             self.totals.push(TexelCounts::default());
             self.pooled.resize(self.pooled.len() + texels, 1.0);
             self.darkest.push(1.0);
         }
         let index = first / stride;
-        for (slot, &count) in seen.iter().enumerate() {
+        for (slot, &count) in seen.counts.iter().enumerate() {
             self.counts[first + slot].add(count);
             if slot < texels {
                 self.totals[index].add(count);
             }
+        }
+        let brought = &mut self.brought[index * self.sources as usize..];
+        for (sum, &value) in brought.iter_mut().zip(seen.brought.iter()) {
+            *sum += value;
         }
         index
     }
@@ -482,6 +498,8 @@ pub struct FieldCell<'a> {
     pooled: &'a [f32],
     /// The counts of the rays aimed at each source.
     sources: &'a [TexelCounts],
+    /// What the rays that reached each source brought.
+    brought: &'a [f64],
     total: TexelCounts,
     /// The lowest visibility of its texels.
     darkest: f32,
@@ -526,6 +544,14 @@ impl FieldCell<'_> {
     /// The counts of the rays aimed at `source` (zero where the field does not count it).
     pub fn source_counts(&self, source: usize) -> TexelCounts {
         self.sources.get(source).copied().unwrap_or_default()
+    }
+
+    /// The sum of what the rays that reached `source` brought, as the host recorded it
+    /// ([`CellRecorder::record_brought`]; 0 where the field does not count it). Over a
+    /// cell's sources these sums share one denominator (the cell's gathers), so their
+    /// ratios estimate the sources' shares of the light the cell receives.
+    pub fn source_brought(&self, source: usize) -> f64 {
+        self.brought.get(source).copied().unwrap_or(0.0)
     }
 
     /// The lowest visibility of the cell's texels.
@@ -579,7 +605,15 @@ impl FieldCell<'_> {
 pub struct FieldObservations {
     side: u32,
     sources: u32,
-    cells: KeyMap<Box<[TexelCounts]>>,
+    cells: KeyMap<CellSeen>,
+}
+
+/// What a tile saw in one cell: its texels' and sources' counts, and what the rays that
+/// reached each source brought.
+#[derive(Clone, Debug)]
+struct CellSeen {
+    counts: Box<[TexelCounts]>,
+    brought: Box<[f64]>,
 }
 
 impl FieldObservations {
@@ -610,12 +644,14 @@ impl FieldObservations {
     /// The counts of cell `key`, to record a gather's rays with one hash probe.
     pub fn cell_mut(&mut self, key: CellKey) -> CellRecorder<'_> {
         let slots = (self.side * self.side + self.sources) as usize;
-        let counts = self
-            .cells
-            .entry(key)
-            .or_insert_with(|| vec![TexelCounts::default(); slots].into_boxed_slice());
+        let sources = self.sources as usize;
+        let seen = self.cells.entry(key).or_insert_with(|| CellSeen {
+            counts: vec![TexelCounts::default(); slots].into_boxed_slice(),
+            brought: vec![0.0; sources].into_boxed_slice(),
+        });
         CellRecorder {
-            counts,
+            counts: &mut seen.counts,
+            brought: &mut seen.brought,
             side: self.side,
         }
     }
@@ -634,14 +670,17 @@ impl FieldObservations {
     pub fn memory_bytes(&self) -> usize {
         let slots = (self.side * self.side + self.sources) as usize;
         std::mem::size_of::<Self>()
-            + self.cells.capacity() * std::mem::size_of::<(CellKey, Box<[TexelCounts]>)>()
-            + self.cells.len() * slots * std::mem::size_of::<TexelCounts>()
+            + self.cells.capacity() * std::mem::size_of::<(CellKey, CellSeen)>()
+            + self.cells.len()
+                * (slots * std::mem::size_of::<TexelCounts>()
+                    + self.sources as usize * std::mem::size_of::<f64>())
     }
 }
 
 /// One cell's counts in [`FieldObservations`], for the rays of one gather.
 pub struct CellRecorder<'a> {
     counts: &'a mut [TexelCounts],
+    brought: &'a mut [f64],
     side: u32,
 }
 
@@ -662,6 +701,17 @@ impl CellRecorder<'_> {
         let texels = (self.side * self.side) as usize;
         if let Some(counts) = self.counts[texels..].get_mut(source) {
             count(counts, free);
+        }
+    }
+
+    /// Adds what a ray that reached `source` brought, weighed as the host's estimate weighs
+    /// it (its value over its density, times any roulette weight), so that the sums over
+    /// all of a cell's candidates estimate each source's part of its light (a source the
+    /// observations do not count is ignored).
+    #[inline]
+    pub fn record_brought(&mut self, source: usize, value: f64) {
+        if let Some(sum) = self.brought.get_mut(source) {
+            *sum += value;
         }
     }
 }
@@ -985,5 +1035,28 @@ mod tests {
         assert!(seen > 0.4 && blocked < 0.05, "{seen} {blocked}");
         assert_eq!(field.cell(&other).unwrap().total().traced, 1);
         assert_eq!(field.cell(&other).unwrap().source_counts(0).traced, 0);
+    }
+
+    #[test]
+    fn what_sources_brought_is_summed_per_cell_across_merges() {
+        let mut field = VisibilityField::new(4).with_sources(2);
+        let key = CellKey::new([1.0, 2.0, 3.0], [0.0, 0.0, 1.0], 0);
+        let other = CellKey::new([9.0, 2.0, 3.0], [0.0, 0.0, 1.0], 0);
+        let mut first = FieldObservations::new(4).with_sources(2);
+        let mut cell = first.cell_mut(key);
+        cell.record_brought(0, 0.25);
+        cell.record_brought(1, 2.0);
+        cell.record_brought(1, 1.0);
+        cell.record_brought(5, 100.0); // not counted: ignored
+        first.cell_mut(other).record_brought(0, 7.0);
+        let mut second = FieldObservations::new(4).with_sources(2);
+        second.cell_mut(key).record_brought(0, 0.5);
+        field.merge_all([&first, &second]);
+        let cell = field.cell(&key).unwrap();
+        assert_eq!(cell.source_brought(0), 0.75);
+        assert_eq!(cell.source_brought(1), 3.0);
+        assert_eq!(cell.source_brought(5), 0.0);
+        assert_eq!(field.cell(&other).unwrap().source_brought(0), 7.0);
+        assert_eq!(field.cell(&other).unwrap().source_brought(1), 0.0);
     }
 }

@@ -244,8 +244,8 @@ fn run_one_by_one<P: BatchProbe>(
 
 /// Records a traced candidate toward `toward` (weighed `weight` = 1 / acceptance) in the
 /// batch, and what it teaches in `lessons`: whether its ray was free (in its direction's
-/// texel, and for the light it aimed at), its value at every MIS share, and its weighted
-/// value for the gather's spread.
+/// texel, and for the light it aimed at), what it brought from that light, its value at
+/// every MIS share, and its weighted value for the gather's spread.
 fn record(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
@@ -254,13 +254,14 @@ fn record(
     traced: &Traced,
     weight: f32,
 ) {
+    let value = luminance(traced.value);
     if let (Some(recorder), Some(free)) = (lessons.cell.as_deref_mut(), traced.free) {
         recorder.record(toward.direction.into(), free);
         if let Some(source) = traced.source {
             recorder.record_source(source, free);
+            recorder.record_brought(source, value as f64 * weight as f64);
         }
     }
-    let value = luminance(traced.value);
     if let (Some(shares), Some(parts), true) =
         (lessons.shares.as_deref_mut(), traced.parts, value > 0.0)
     {

@@ -126,33 +126,40 @@ impl FieldGuides {
 }
 
 /// The choice among the lights in `cell`: each light's power share `power[l]` and, with
-/// share `fraction`, that share weighed by the visibility of the rays the cell aimed at it
-/// (a light it aimed no ray at counts as the cell's visibility). `None` where the field
-/// counts no lights, the cell has too little evidence, or no light is much less visible
-/// than the others (then the choice by power is as good).
+/// share `fraction`, a share learned from what the cell's rays brought from each light,
+/// `B_l / √v_l` normalised (`B_l` the light's part of the cell's light, `v_l` the
+/// visibility of the rays aimed at it). That is the variance-optimal choice where a light's
+/// own sampling brings `B_l / v_l` through a free ray and nothing through a blocked one
+/// (docs/technique.md, "Choosing among lights"): a close light under a roof gets the draws a
+/// hidden sun would waste, though by power it is a hundredth of the sky. `None` where the
+/// field counts no lights, the cell has too little evidence, or no ray brought light.
 fn light_choice(power: &[f64], cell: &FieldCell, fraction: f64) -> Option<AliasTable> {
     if power.is_empty() || cell.total().traced < LEAST_EVIDENCE {
         return None;
     }
     let visibility = cell.visibility();
-    let seen: Vec<f64> = (0..power.len())
-        .map(|light| cell.source_visibility(light).unwrap_or(visibility) as f64)
+    let learned: Vec<f64> = (0..power.len())
+        .map(|light| {
+            let seen = cell.source_visibility(light).unwrap_or(visibility) as f64;
+            cell.source_brought(light) / seen.max(LEAST_SOURCE_VISIBILITY).sqrt()
+        })
         .collect();
-    let free: f64 = power.iter().zip(&seen).map(|(p, v)| p * v).sum();
-    let contrast = power
-        .iter()
-        .zip(&seen)
-        .any(|(&p, &v)| p > 0.0 && v < GUIDE_CONTRAST as f64 * free);
-    if !(free > 0.0 && contrast) {
+    let total: f64 = learned.iter().sum();
+    if !(total > 0.0 && total.is_finite()) {
         return None;
     }
     let weights: Vec<f64> = power
         .iter()
-        .zip(&seen)
-        .map(|(p, v)| (1.0 - fraction) * p + fraction * p * v / free)
+        .zip(&learned)
+        .map(|(p, b)| (1.0 - fraction) * p + fraction * b / total)
         .collect();
     Some(AliasTable::new(&weights))
 }
+
+/// The visibility below which a light's is not trusted to raise its choice further (a
+/// light seen by one ray in a hundred, whose few free rays brought much, is not chosen
+/// more than ten times its share of the light).
+pub const LEAST_SOURCE_VISIBILITY: f64 = 0.01;
 
 /// A texel whose 2 × 2 block no ray of a cell went to (behind the surface, or where light
 /// sampling never draws) weighs this share of the cell's visibility in its guide. Such
@@ -189,4 +196,56 @@ fn build(
     let unseen = UNSEEN_TEXEL_SHARE * visibility;
     guide.set_affinities(|texel| cell.pooled_visibility_at(texel).unwrap_or(unseen));
     Some(guide)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use ais::field::{CellKey, FieldObservations, VisibilityField};
+
+    /// A field of one cell whose rays aimed at a sky (source 0) were mostly blocked and
+    /// brought little, and at a lamp (source 1) were free and brought much.
+    fn cell_under_a_roof(brought: bool) -> (VisibilityField, CellKey) {
+        let key = CellKey::new([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], 0);
+        let mut observations = FieldObservations::new(4).with_sources(2);
+        let mut cell = observations.cell_mut(key);
+        for ray in 0..64 {
+            let (source, free) = if ray < 40 {
+                (0, ray % 10 == 0)
+            } else {
+                (1, true)
+            };
+            cell.record([0.0, 0.0, 1.0], free);
+            cell.record_source(source, free);
+            if brought && free {
+                cell.record_brought(source, if source == 0 { 0.05 } else { 0.125 });
+            }
+        }
+        let mut field = VisibilityField::new(4).with_sources(2);
+        field.merge(&observations);
+        (field, key)
+    }
+
+    #[test]
+    fn a_cell_chooses_the_lights_that_brought_its_light() {
+        let (field, key) = cell_under_a_roof(true);
+        let cell = field.cell(&key).unwrap();
+        let power = [0.99, 0.01];
+        let choice = light_choice(&power, &cell, 0.75).expect("learned");
+        // The sky brought 0.2 through a tenth of its rays, the lamp 3 through all of
+        // them: the learned shares are 0.2 / √0.1 against 3 / √1 (up to the prior).
+        let lamp = choice.probability(1) as f64;
+        let sky = choice.probability(0) as f64;
+        assert!(lamp > 0.6, "the lamp's share {lamp}");
+        // The defensive share keeps every light at least a quarter of its power share.
+        assert!(sky >= 0.25 * 0.99 - 1e-6, "the sky's share {sky}");
+        assert!((sky + lamp - 1.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn a_cell_whose_rays_brought_nothing_chooses_by_power() {
+        let (field, key) = cell_under_a_roof(false);
+        let cell = field.cell(&key).unwrap();
+        assert!(light_choice(&[0.99, 0.01], &cell, 0.75).is_none());
+    }
 }
