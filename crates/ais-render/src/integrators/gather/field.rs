@@ -68,16 +68,15 @@ pub fn counted_sources(world: &World) -> usize {
 }
 
 /// Whether the field can change anything in `world` with these settings (`map = field`):
-/// its roulette runs ([`field_rolls`]), or it can guide light sampling toward an
-/// environment. Elsewhere (area lights only, and fewer than [`LEAST_ROLLING_RAYS`]
-/// candidates) the gather renders as AIS off, nothing recorded or timed: in one pass, or,
-/// where [`chooses_sizes`], in passes whose race passes measure the pixels. (Where
-/// the field learns, it also guides the choice among two or more lights; alone, that did
-/// not pay for the learning passes: with four sphere lights among pillars it left relMSE
-/// unchanged, which pixel sampling dominates there, and cost 7% more time.)
+/// its roulette runs ([`field_rolls`]), or it can guide light sampling: toward an
+/// environment, or in the choice among two or more lights. Elsewhere (one area light, and
+/// fewer than [`LEAST_ROLLING_RAYS`] candidates) the gather renders as AIS off, nothing
+/// recorded or timed: in one pass, or, where [`chooses_sizes`], in passes whose race
+/// passes measure the pixels.
 pub fn field_has_use(world: &World, settings: &GatherSettings) -> bool {
+    let guidable = world.lights.environment.is_some() || counted_sources(world) > 0;
     let guides = settings.map_use.guides()
-        && world.lights.environment.is_some()
+        && guidable
         && matches!(settings.strategy, Strategy::Light | Strategy::Mis);
     settings.map == MapSource::Field && (field_rolls(settings) || guides)
 }
