@@ -1,10 +1,10 @@
 //! Light sampling guided by the visibility field (`map = field` with `map_use = proposal`
 //! or `both`).
 //!
-//! Where a scene has two or more lights, a cell also chooses among them by what it saw:
-//! each light's probability of being chosen is a defensive mixture of its share of the
-//! power (as unguided light sampling chooses) and that share weighed by the visibility of
-//! the rays the cell aimed at it. A light hidden from the cell is chosen less, one in view
+//! Where a scene has two or more lights, a cell also chooses among them by what their rays
+//! brought it: each light's probability of being chosen is a defensive mixture of its share
+//! of the power (as unguided light sampling chooses) and its learned share of the cell's
+//! light. A light hidden from the cell, or far from it, is chosen less, a close one in view
 //! more; the choice's probabilities are exact, so nothing is biased.
 //!
 //! In a cell whose texels the field knows, the environment is drawn from a defensive
