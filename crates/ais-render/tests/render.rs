@@ -225,6 +225,19 @@ fn the_default_gather_guides_without_timing_and_is_reproducible() {
 }
 
 #[test]
+fn the_light_choice_learned_from_what_lights_brought_is_thread_independent() {
+    // A sky with a sun and a lamp under a roof: cells choose among the two by what their
+    // rays brought, sums of floats that add in tile order between passes, so the image is
+    // the same at any thread count.
+    let world = common::shipped_scene_at("occluded.xml", (40, 24));
+    let auto = Integrator::Gather(GatherSettings::default());
+    let one = on_threads_at(&world, 1, auto, 8);
+    let two = on_threads_at(&world, 2, auto, 8);
+    assert!(one.stats.field_guided > 0, "the field guides");
+    assert_eq!(bits(&one.image), bits(&two.image));
+}
+
+#[test]
 fn the_learned_mis_share_is_thread_independent() {
     // A courtyard, where most gathers see the sky: the first pass has gathers enough to
     // choose MIS's BSDF share, summed in tile order.
