@@ -12,7 +12,7 @@ use super::{batch_for, note_gather_variance, GatherSettings, GatherTile, MapSour
 use crate::geometry::Hit;
 use crate::render::{Learning, PassEnd, RayCounts};
 use crate::world::World;
-use ais::field::{CellIndex, CellKey, FieldCell, FieldObservations, VisibilityField};
+use ais::field::{CellIndex, CellKey, FieldCell, FieldObservations, VisibilityField, MOST_SOURCES};
 use ais::MapStart;
 use glam::Vec3;
 use std::cell::Cell;
@@ -58,11 +58,13 @@ pub fn field_rolls(settings: &GatherSettings) -> bool {
     settings.map_use.rolls() && settings.rays >= LEAST_ROLLING_RAYS
 }
 
-/// The lights whose rays the field counts per cell, to choose among them by what a cell
-/// sees: all of light sampling's choices where there are two or more, else none.
+/// The lights whose rays the field counts per cell, to choose among them by what each
+/// brought: all of light sampling's choices where there are two or more, else none; none
+/// either beyond [`MOST_SOURCES`], where a cell could learn only some of them and the
+/// others would keep no more than the choice's defensive share.
 pub fn counted_sources(world: &World) -> usize {
     match world.lights.source_count() {
-        count if count >= 2 => count,
+        count if (2..=MOST_SOURCES as usize).contains(&count) => count,
         _ => 0,
     }
 }
