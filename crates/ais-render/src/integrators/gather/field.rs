@@ -76,13 +76,13 @@ pub fn counted_sources(world: &World) -> usize {
 /// recorded or timed: in one pass, or, where [`chooses_sizes`], in passes whose race
 /// passes measure the pixels.
 pub fn field_has_use(world: &World, settings: &GatherSettings) -> bool {
-    settings.map == MapSource::Field && (field_rolls(settings) || field_guides(world, settings))
+    settings.map == MapSource::Field && (field_rolls(settings) || field_can_guide(world, settings))
 }
 
 /// Whether the field can guide light sampling in `world` with these settings: light
 /// sampling is in the proposal, `map_use` guides, and there is an environment to draw or a
 /// choice among two or more lights.
-pub fn field_guides(world: &World, settings: &GatherSettings) -> bool {
+pub fn field_can_guide(world: &World, settings: &GatherSettings) -> bool {
     let guidable = world.lights.environment.is_some() || counted_sources(world) > 0;
     settings.map_use.guides()
         && guidable
@@ -191,7 +191,7 @@ pub struct GatherLearning {
     pinned_cost_ratio: Option<f32>,
     /// Whether the gathers roll ([`field_rolls`]).
     rolls: bool,
-    /// Whether the field can guide light sampling ([`field_guides`]).
+    /// Whether the field can guide light sampling ([`field_can_guide`]).
     guides: bool,
     /// Guided and all gathers of the pass being merged.
     guided: [u64; 2],
@@ -234,7 +234,7 @@ impl GatherLearning {
             pending: Vec::new(),
             pinned_cost_ratio: settings.cost_ratio,
             rolls: field_rolls(settings),
-            guides: field_guides(world, settings),
+            guides: field_can_guide(world, settings),
             guided: [0; 2],
             guided_share: None,
             passes: 0,
