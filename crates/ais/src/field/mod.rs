@@ -9,7 +9,8 @@
 //!   number of threads.
 //! - [`FieldObservations`] is per-thread scratch: the rays a tile traced, counted per cell
 //!   and texel. Between passes the host merges every tile's observations into the field.
-//!   Counts are integers, so the merged field is the same in whatever order tiles finish.
+//!   Counts are integers, so the merged counts are the same in whatever order tiles finish;
+//!   what sources brought are float sums, the same for a fixed merging order (by tile).
 //!
 //! Cells are keyed by position on a hashed grid whose spacing the host chooses per lookup,
 //! as a power of two (so that it can follow the pixel footprint: a cell covers a few pixels
@@ -334,7 +335,8 @@ impl VisibilityField {
     }
 
     /// Adds what several tiles observed (a pass's), then works out each cell they touched
-    /// once: the same field as merging them one by one, in any order, for less work (a
+    /// once: the same field as merging them one by one (in any order for the counts; in
+    /// the same order for what sources brought), for less work (a
     /// cell that several tiles saw is pooled once, not once per tile).
     pub fn merge_all<'o>(&mut self, all: impl IntoIterator<Item = &'o FieldObservations>) {
         let mut touched = Vec::new();

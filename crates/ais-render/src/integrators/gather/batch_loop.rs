@@ -255,11 +255,13 @@ fn record(
     weight: f32,
 ) {
     let value = luminance(traced.value);
+    // What the candidate adds to the gather's estimate.
+    let weighted = value as f64 * weight as f64;
     if let (Some(recorder), Some(free)) = (lessons.cell.as_deref_mut(), traced.free) {
         recorder.record(toward.direction.into(), free);
         if let Some(source) = traced.source {
             recorder.record_source(source, free);
-            recorder.record_brought(source, value as f64 * weight as f64);
+            recorder.record_brought(source, weighted);
         }
     }
     if let (Some(shares), Some(parts), true) =
@@ -268,7 +270,7 @@ fn record(
         shares.add(value, parts, run.at.mis_bsdf_share);
     }
     if let Some(spread) = lessons.spread.as_deref_mut() {
-        spread.add(value as f64 * weight as f64);
+        spread.add(weighted);
     }
     batch.record(traced.value.to_array(), traced.rating);
 }

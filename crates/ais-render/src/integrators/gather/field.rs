@@ -290,7 +290,7 @@ impl GatherLearning {
     /// than [`LEAST_ROLLING_SHARE`] of the rays, and its last pass guided fewer than
     /// [`LEAST_GUIDED_SHARE`] of the gathers it could guide (a rolling field is not judged
     /// by its guiding until a pass has read it). A field that guides is raced, even where
-    /// it rolls little: its choice among lights gained 1.7× at 128 candidates behind a
+    /// it rolls little: its choice among lights gained 1.7–2.0× at 128 candidates behind a
     /// roof edge, where roulette pays almost nowhere.
     fn little_use(&self) -> bool {
         let rolls_little = !self.rolls
