@@ -425,6 +425,9 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
         // A sky with a sun and a lamp under a roof: the cells under it choose the lamp by
         // what it brought them, far above its share of the power.
         ("occluded.xml", Strategy::Mis, MapUse::Proposal, false),
+        // A rectangle light seen through a door gap: the cells draw the parts of the light
+        // they see, weighing the regions of its sample square by what each brought.
+        ("door_gap.xml", Strategy::Mis, MapUse::Proposal, false),
     ];
     for (scene, strategy, map_use, field_race) in cases {
         // At 12 × 8 pixels the default cells (16 footprints) would span the image, and
@@ -467,7 +470,7 @@ fn gathers_with_the_sizes_the_race_chose_are_unbiased() {
     // Two rooms at 48 × 32 pixels, where what the camera sees dominates the noise: after
     // the race passes (4 samples) the other 28 gather with fewer candidates, chosen per
     // block. The interior is lit by a sky the field guides toward; the door gap by a
-    // rectangle light alone, where the field has no use and the gathers are AIS off's.
+    // rectangle light alone, whose regions the field weighs.
     // Emitters seen directly are hidden, so that every pixel is gathered light. The
     // image's mean agrees with AIS off's within 4 standard errors (an estimate 5% off in
     // the sized gathers fails), and its pixels' z² average below 2. (Single pixels' |z| is

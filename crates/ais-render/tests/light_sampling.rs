@@ -17,7 +17,7 @@ use ais_render::integrators::gather::strategy::MIS_BSDF_WEIGHT;
 use ais_render::integrators::gather::{GatherPoint, Strategy};
 use ais_render::lights::{
     AreaLight, AreaShape, Emitters, Environment, EnvironmentGuide, EnvironmentMap,
-    EnvironmentPartition, GuideLayout, Lights, Receiver, Rectangle, Toward,
+    EnvironmentPartition, GuideLayout, Lights, Receiver, Rectangle, RegionChoice, Toward, REGIONS,
 };
 use base64::Engine;
 use glam::{DMat3, Vec3};
@@ -426,6 +426,66 @@ fn a_learned_choice_among_the_lights_fits() {
     assert_eq!(lights.source_count(), 3);
     let power = lights.power_choice();
     assert!((power.iter().sum::<f64>() - 1.0).abs() < 1e-5, "{power:?}");
+}
+
+#[test]
+fn weighed_regions_of_a_rectangle_and_a_sphere_fit() {
+    // A field cell's weighing of the regions of each light's sample square: the draws
+    // follow it, the density found along any direction (through the lights' inverse maps)
+    // is the one each draw reports (through the region it was drawn in), and it integrates
+    // to one.
+    let rectangle = Rectangle::new(
+        Vec3::new(-0.6, -0.5, 1.0),
+        Vec3::new(1.2, 0.0, 0.4),
+        Vec3::new(0.0, 0.9, 0.0),
+        true,
+    )
+    .expect("orthogonal edges");
+    let lamp = AreaLight {
+        shape: AreaShape::Rectangle(rectangle),
+        radiance: Vec3::splat(3.0),
+        texture: None,
+        shape_index: 0,
+    };
+    let ball = AreaLight {
+        shape: AreaShape::Sphere {
+            sphere: Sphere {
+                center: Vec3::new(-1.2, 0.4, 0.8),
+                radius: 0.5,
+            },
+            flipped: false,
+        },
+        radiance: Vec3::splat(5.0),
+        texture: None,
+        shape_index: 1,
+    };
+    let emitters = Emitters {
+        environment: None,
+        area: vec![lamp, ball],
+        delta: Vec::new(),
+    };
+    let lights = Lights::new(emitters, 2, 3.0);
+    assert_eq!(lights.field_sources(), 2 * REGIONS);
+    let weights = |seed: usize| -> [f64; REGIONS] {
+        std::array::from_fn(|k| 0.05 + ((k * 7 + seed) % 11) as f64)
+    };
+    let regions = [
+        Some(RegionChoice::new(&weights(1)).unwrap()),
+        Some(RegionChoice::new(&weights(4)).unwrap()),
+    ];
+    let mut receiver = Receiver::new(Vec3::new(0.1, -0.1, 0.0));
+    receiver.region_choices = &regions;
+    let p = fit(
+        200_000,
+        17,
+        |u| {
+            let mut toward = lights.sample_toward(&receiver, u)?;
+            let pdf = lights.pdf_toward(&receiver, &mut toward);
+            (pdf > 0.0).then_some((toward.direction, pdf))
+        },
+        |d| lights.pdf_over_directions(&receiver, d),
+    );
+    assert!(p > SIGNIFICANCE, "p = {p}");
 }
 
 /// A tilted surface seen obliquely, where the proposal tests gather.

@@ -308,6 +308,45 @@ impl AreaLight {
         }
     }
 
+    /// Whether light sampling draws this light through a one-to-one map of the sample
+    /// square that [`AreaLight::sample_square_of`] inverts (spheres and rectangles), so that
+    /// the square's regions can be weighed ([`super::RegionChoice`]).
+    pub fn has_regions(&self) -> bool {
+        matches!(
+            self.shape,
+            AreaShape::Sphere { .. } | AreaShape::Rectangle(_)
+        )
+    }
+
+    /// The point of the sample square from which [`AreaLight::sample_for`] draws the point
+    /// `target` of the light, seen along `direction` from `receiver` (`None` for lights
+    /// without regions, or where the receiver sees nothing of the light).
+    pub fn sample_square_of(
+        &self,
+        receiver: &Receiver,
+        direction: Vec3,
+        target: Vec3,
+    ) -> Option<[f32; 2]> {
+        match &self.shape {
+            AreaShape::Sphere { sphere, .. } => {
+                let (axis, cos_max) = subtended_cone(sphere, receiver.point)?;
+                let direction = direction.as_dvec3();
+                let (t, b) = crate::geometry::basis(axis);
+                let u0 = (1.0 - direction.dot(axis.as_dvec3())) / (1.0 - cos_max);
+                let phi = direction
+                    .dot(b.as_dvec3())
+                    .atan2(direction.dot(t.as_dvec3()));
+                let u1 = phi.rem_euclid(2.0 * PI) / (2.0 * PI);
+                Some([u0, u1].map(|c| (c as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0)))
+            }
+            AreaShape::Rectangle(rectangle) => {
+                let view = receiver.rectangle_view(rectangle)?;
+                Some(Rectangle::square_of(&view, target - receiver.point))
+            }
+            _ => None,
+        }
+    }
+
     /// The nearest point of the light along a ray.
     pub fn intersect(&self, ray: &Ray) -> Option<AreaHit> {
         let (distance, normal) = match &self.shape {

@@ -9,6 +9,7 @@ mod environment_guide;
 mod mesh_emitter;
 pub(crate) mod reader;
 mod receiver;
+mod regions;
 mod spherical_rectangle;
 mod toward;
 
@@ -18,6 +19,7 @@ pub use environment::{luminance, Environment, EnvironmentMap};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout};
 pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
+pub use regions::{region_of, RegionChoice, REGIONS, REGION_SIDE};
 pub use spherical_rectangle::{Rectangle, LEAST_F32_SOLID_ANGLE};
 pub use toward::Toward;
 use toward::{AreaPoint, Source};
@@ -40,6 +42,33 @@ pub struct Lights {
     pub shape_lights: Vec<Option<usize>>,
     /// Choice of a light: area lights first, then delta lights, then the environment.
     choice: Option<AliasTable>,
+    /// Where a field cell counts each light's rays ([`Lights::source_of`]).
+    sources: SourceLayout,
+}
+
+/// Where a field cell counts each light's rays: one source per light, or, for the lights
+/// with regions ([`AreaLight::has_regions`]), one per region of the light's sample square,
+/// as long as the scene's sources stay within what a cell counts
+/// ([`ais::field::MOST_SOURCES`]).
+#[derive(Clone, Debug, Default)]
+struct SourceLayout {
+    /// Each light's first source (in the order light sampling chooses them), then the
+    /// number of sources.
+    first: Vec<usize>,
+}
+
+impl SourceLayout {
+    /// The layout for lights of which those flagged in `regions` have regions.
+    fn new(regions: &[bool]) -> Self {
+        let with_regions: usize = regions.iter().map(|&r| if r { REGIONS } else { 1 }).sum();
+        let split = with_regions <= ais::field::MOST_SOURCES as usize;
+        let mut first = vec![0];
+        for &r in regions {
+            let count = if r && split { REGIONS } else { 1 };
+            first.push(first.last().copied().unwrap_or(0) + count);
+        }
+        SourceLayout { first }
+    }
 }
 
 /// Where a candidate's shadow ray goes ([`Lights::aim`]).
@@ -83,12 +112,15 @@ impl Lights {
             weights.push(PI * environment.mean_luminance() * PI * scene_radius * scene_radius);
         }
         let choice = (!weights.is_empty()).then(|| AliasTable::new(&weights));
+        let mut regions: Vec<bool> = area.iter().map(AreaLight::has_regions).collect();
+        regions.resize(weights.len(), false);
         Lights {
             environment,
             area,
             delta,
             shape_lights,
             choice,
+            sources: SourceLayout::new(&regions),
         }
     }
 
@@ -108,24 +140,50 @@ impl Lights {
         self.environment_index() + usize::from(self.environment.is_some())
     }
 
-    /// The probabilities of choosing each light by its power (indexed as
-    /// [`Lights::source_of`]).
+    /// How many sources a field cell counts the lights' rays by ([`Lights::source_of`]):
+    /// one per light, or one per region of a light's sample square.
+    pub fn field_sources(&self) -> usize {
+        self.sources.first.last().copied().unwrap_or(0)
+    }
+
+    /// The sources of light `index` (in the order light sampling chooses them): one, or
+    /// one per region of its sample square ([`REGIONS`], indexed as [`region_of`]).
+    pub fn sources_of_light(&self, index: usize) -> std::ops::Range<usize> {
+        self.sources.first[index]..self.sources.first[index + 1]
+    }
+
+    /// The probabilities of choosing each light by its power (indexed as light sampling
+    /// chooses them: area lights, delta lights, the environment).
     pub fn power_choice(&self) -> Vec<f64> {
         (0..self.source_count())
             .map(|index| self.power_probability(index))
             .collect()
     }
 
-    /// The light that `toward` (resolved) meets first, indexed as light sampling chooses
-    /// them: area lights, delta lights, the environment (`None`: nothing emits along it, or
-    /// it was not resolved).
-    pub fn source_of(&self, toward: &Toward) -> Option<usize> {
-        match toward.source {
-            Source::Area(point) => Some(point.light),
-            Source::Delta(delta, _) => Some(self.area.len() + delta),
-            Source::Environment => Some(self.environment_index()),
-            Source::Dark | Source::Unknown => None,
+    /// The field's source (see [`Lights::field_sources`]) that `toward` (resolved) meets
+    /// first: the light, and for a light counted by regions, the region of its sample
+    /// square that the point met lies in (`None`: nothing emits along it, or it was not
+    /// resolved).
+    pub fn source_of(&self, receiver: &Receiver, toward: &Toward) -> Option<usize> {
+        let light = match toward.source {
+            Source::Area(point) => point.light,
+            Source::Delta(delta, _) => self.area.len() + delta,
+            Source::Environment => self.environment_index(),
+            Source::Dark | Source::Unknown => return None,
+        };
+        let sources = self.sources_of_light(light);
+        if sources.len() == 1 {
+            return Some(sources.start);
         }
+        let Source::Area(point) = toward.source else {
+            return Some(sources.start);
+        };
+        let region = point.region.map(usize::from).or_else(|| {
+            let square =
+                self.area[light].sample_square_of(receiver, toward.direction, point.target);
+            square.map(region_of)
+        })?;
+        Some(sources.start + region)
     }
 
     /// The choice of a light for `receiver`: its own (a field cell's), else by power.
@@ -165,13 +223,23 @@ impl Lights {
         let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
             let light = &self.area[index];
-            let sample = light.sample_for(receiver, [u0, u[1]])?;
+            let square = [u0, u[1]];
+            // A receiver that weighs the light's regions draws the square's point from them.
+            let (square, region, factor) = match receiver.region_choice(index) {
+                Some(regions) => {
+                    let (square, region) = regions.sample(square);
+                    (square, region, regions.factor(region))
+                }
+                None => (square, region_of(square), 1.0),
+            };
+            let sample = light.sample_for(receiver, square)?;
             let target = receiver.point + sample.direction * sample.distance;
             let point = AreaPoint {
                 light: index,
                 target,
                 radiance: light.emitted(sample.normal, sample.direction, target, sample.spot),
-                density: choice.probability(index) as f64 * sample.pdf,
+                density: choice.probability(index) as f64 * sample.pdf * factor,
+                region: Some(region as u8),
             };
             return Some(Toward::area(sample.direction, point));
         }
@@ -208,7 +276,8 @@ impl Lights {
         for (index, light) in self.area.iter().enumerate() {
             let p = self.choice_probability(receiver, index);
             if p > 0.0 {
-                pdf += p * light.pdf_for(receiver, direction);
+                let (factor, _) = self.region_factor(receiver, index, direction, None);
+                pdf += p * light.pdf_for(receiver, direction) * factor;
             }
         }
         pdf + self.environment_density(receiver, &mut Toward::new(direction))
@@ -322,16 +391,44 @@ impl Lights {
                 let density =
                     light.density_at(receiver, toward.direction, hit.distance, hit.normal);
                 let target = receiver.point + toward.direction * hit.distance;
+                let (factor, region) =
+                    self.region_factor(receiver, index, toward.direction, Some(target));
                 Source::Area(AreaPoint {
                     light: index,
                     target,
                     radiance: light.emitted(hit.normal, toward.direction, target, hit.spot),
-                    density: self.choice_probability(receiver, index) * density,
+                    density: self.choice_probability(receiver, index) * density * factor,
+                    region,
                 })
             }
             None if self.environment.is_some() => Source::Environment,
             None => Source::Dark,
         };
+    }
+
+    /// The factor that `receiver`'s weighing of area light `index`'s regions puts on the
+    /// light's density along `direction` (toward `target` on the light, found if not
+    /// given), and the region (`(1, None)` where the receiver does not weigh them).
+    fn region_factor(
+        &self,
+        receiver: &Receiver,
+        index: usize,
+        direction: Vec3,
+        target: Option<Vec3>,
+    ) -> (f64, Option<u8>) {
+        let Some(regions) = receiver.region_choice(index) else {
+            return (1.0, None);
+        };
+        let light = &self.area[index];
+        let target = target.or_else(|| {
+            let hit = light.intersect(&Ray::new(receiver.point, direction))?;
+            Some(receiver.point + direction * hit.distance)
+        });
+        let square = target.and_then(|t| light.sample_square_of(receiver, direction, t));
+        match square.map(region_of) {
+            Some(region) => (regions.factor(region), Some(region as u8)),
+            None => (1.0, None),
+        }
     }
 
     /// Radiance of the environment in `direction` (black without one).

@@ -6,7 +6,7 @@
 //! the gather's other candidates, in a few direct-mapped slots (no allocation).
 
 use super::spherical_rectangle::{Rectangle, View};
-use super::EnvironmentGuide;
+use super::{EnvironmentGuide, RegionChoice};
 use ais::sampling::AliasTable;
 use glam::Vec3;
 use std::cell::Cell;
@@ -27,6 +27,9 @@ pub struct Receiver<'a> {
     /// Light sampling chooses among the lights by this table (a field cell's learned
     /// choice), or by their power (`None`).
     pub light_choice: Option<&'a AliasTable>,
+    /// Light sampling draws area light `l`'s sample square from `region_choices[l]` where
+    /// that is given (a field cell's learned regions), else uniformly.
+    pub region_choices: &'a [Option<RegionChoice>],
     views: [ViewSlot; VIEW_SLOTS],
 }
 
@@ -37,6 +40,7 @@ impl<'a> Receiver<'a> {
             point,
             environment_guide: None,
             light_choice: None,
+            region_choices: &[],
             views: Default::default(),
         }
     }
@@ -47,6 +51,12 @@ impl<'a> Receiver<'a> {
             environment_guide: Some(guide),
             ..Receiver::new(point)
         }
+    }
+
+    /// The weighing of area light `light`'s regions, if the receiver has one.
+    #[inline]
+    pub fn region_choice(&self, light: usize) -> Option<&'a RegionChoice> {
+        self.region_choices.get(light)?.as_ref()
     }
 
     /// How `rectangle` looks from the point (None: seen edge-on), computed on first use.

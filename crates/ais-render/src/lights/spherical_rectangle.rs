@@ -4,7 +4,7 @@
 //! oblique the rectangle is.
 
 use crate::geometry::Ray;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
 
 /// A rectangle: a corner and two orthogonal edges; it emits toward `normal`.
@@ -81,6 +81,8 @@ trait Real:
     fn of(value: f64) -> Self;
     /// This value in f32.
     fn as_f32(self) -> f32;
+    /// This value in f64.
+    fn as_f64(self) -> f64;
     fn sqrt(self) -> Self;
     fn sin_cos(self) -> (Self, Self);
     fn copysign(self, sign: Self) -> Self;
@@ -98,6 +100,10 @@ macro_rules! real {
             #[inline]
             fn as_f32(self) -> f32 {
                 self as f32
+            }
+            #[inline]
+            fn as_f64(self) -> f64 {
+                self as f64
             }
             #[inline]
             fn sqrt(self) -> Self {
@@ -182,6 +188,41 @@ impl<R: Real> Spherical<R> {
         });
         (Vec3::from(direction), length.as_f32())
     }
+
+    /// The point of the sample square that [`Spherical::sample`] maps to the point at
+    /// `offset` from the receiver (on the rectangle), worked out in f64: `u₀` is the share
+    /// of the solid angle left of the point, `u₁` its place between the rectangle's edges
+    /// along `y`, as the draw measures them.
+    fn square_of(&self, offset: Vec3) -> [f32; 2] {
+        let f = Real::as_f64;
+        let along = |axis: &[R; 3]| (0..3).map(|i| offset[i] as f64 * f(axis[i])).sum::<f64>();
+        let (z0, y0, y1) = (f(self.z0), f(self.y0), f(self.y1));
+        let xu = along(&self.x).clamp(f(self.x0), f(self.x1));
+        let yv = along(&self.y).clamp(y0, y1);
+        // The solid angle of the part [x0, xu] × [y0, y1]: the view's sum with x1 = xu (its
+        // `k` does not depend on x1).
+        let n0 = DVec3::new(0.0, z0, -y0).normalize();
+        let n1 = DVec3::new(-z0, 0.0, xu).normalize();
+        let n2 = DVec3::new(0.0, -z0, y1).normalize();
+        let part = angle_between(n0, n1) + angle_between(n1, n2) - f(self.k);
+        let distance_squared = xu * xu + z0 * z0;
+        let h = |y: f64| y / (distance_squared + y * y).sqrt();
+        let (h0, h1) = (h(y0), h(y1));
+        let v = if h1 > h0 {
+            (h(yv) - h0) / (h1 - h0)
+        } else {
+            0.5
+        };
+        [part / f(self.solid_angle), v].map(|c| (c as f32).clamp(0.0, ONE_BELOW))
+    }
+}
+
+/// The largest f32 below 1.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// The interior angle of a spherical polygon between edges of inner normals `a` and `b`.
+fn angle_between(a: DVec3, b: DVec3) -> f64 {
+    (-a.dot(b)).clamp(-1.0, 1.0).acos()
 }
 
 impl Rectangle {
@@ -228,11 +269,11 @@ impl Rectangle {
         let x0 = d.dot(x);
         let y0 = d.dot(y);
         let (x1, y1) = (x0 + exl, y0 + eyl);
-        let n0 = glam::DVec3::new(0.0, z0, -y0).normalize();
-        let n1 = glam::DVec3::new(-z0, 0.0, x1).normalize();
-        let n2 = glam::DVec3::new(0.0, -z0, y1).normalize();
-        let n3 = glam::DVec3::new(z0, 0.0, -x0).normalize();
-        let angle = |a: glam::DVec3, b: glam::DVec3| (-a.dot(b)).clamp(-1.0, 1.0).acos();
+        let n0 = DVec3::new(0.0, z0, -y0).normalize();
+        let n1 = DVec3::new(-z0, 0.0, x1).normalize();
+        let n2 = DVec3::new(0.0, -z0, y1).normalize();
+        let n3 = DVec3::new(z0, 0.0, -x0).normalize();
+        let angle = angle_between;
         let (g0, g1, g2, g3) = (angle(n0, n1), angle(n1, n2), angle(n2, n3), angle(n3, n0));
         let k = 2.0 * PI - g2 - g3;
         let solid_angle = g0 + g1 - k;
@@ -276,6 +317,15 @@ impl Rectangle {
             Draws::Precise(precise) => precise.sample(u),
         };
         (direction, 1.0 / view.solid_angle, distance)
+    }
+
+    /// The point of the sample square that [`Rectangle::sample_view`] maps to the point
+    /// `offset` from where `view` was seen (a point of the rectangle).
+    pub(crate) fn square_of(view: &View, offset: Vec3) -> [f32; 2] {
+        match &view.draws {
+            Draws::Fast(fast) => fast.square_of(offset),
+            Draws::Precise(precise) => precise.square_of(offset),
+        }
     }
 
     /// The solid angle the rectangle subtends at `point` (0 in its plane).
@@ -343,5 +393,28 @@ mod tests {
             Rectangle::new(Vec3::ZERO, Vec3::X, Vec3::new(1.0, 1.0, 0.0), false).is_none(),
             "sheared"
         );
+    }
+
+    #[test]
+    fn the_inverse_map_finds_the_point_of_the_square_a_direction_was_drawn_from() {
+        // A large view (drawn in f32) and a small one (in f64).
+        let r = Rectangle::new(
+            Vec3::new(0.2, -0.5, 2.0),
+            Vec3::new(1.0, 0.0, 0.3),
+            Vec3::new(0.0, 0.8, 0.0),
+            true,
+        )
+        .unwrap();
+        let mut rng = ais::rng::Pcg32::new(4, 2);
+        for origin in [Vec3::new(0.1, 0.1, 0.0), Vec3::new(30.0, -20.0, -40.0)] {
+            let view = r.view(origin).unwrap();
+            for _ in 0..2000 {
+                let u = [rng.next_f32(), rng.next_f32()];
+                let (direction, _, distance) = Rectangle::sample_view(&view, u);
+                let found = Rectangle::square_of(&view, direction * distance);
+                let error = (found[0] - u[0]).abs().max((found[1] - u[1]).abs());
+                assert!(error < 2e-3, "{u:?} came back as {found:?} from {origin}");
+            }
+        }
     }
 }

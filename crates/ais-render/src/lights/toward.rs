@@ -37,8 +37,12 @@ pub(super) struct AreaPoint {
     /// Radiance it sends toward the receiver (zero from its back side).
     pub radiance: Vec3,
     /// Light sampling's density of drawing this point, in solid angle at the receiver,
-    /// including the choice of the light.
+    /// including the choice of the light (and the weighing of its regions).
     pub density: f64,
+    /// The region of the light's sample square it was drawn from ([`super::region_of`]),
+    /// where known: always for a point drawn by light sampling, for one found along a
+    /// direction where the receiver weighs the light's regions.
+    pub region: Option<u8>,
 }
 
 /// A unit world-space direction, with what it meets and its place on the environment map

@@ -31,6 +31,7 @@ pub mod pooling;
 
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
+use std::ops::Range;
 
 /// What a texel of a cell has seen: rays traced and, of those, rays that were free.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -539,13 +540,28 @@ impl FieldCell<'_> {
     /// cell's visibility, as a texel's), or `None` where the field does not count it or no
     /// such ray was recorded.
     pub fn source_visibility(&self, source: usize) -> Option<f32> {
-        let counts = *self.sources.get(source)?;
+        self.sources_visibility(source..source + 1)
+    }
+
+    /// The visibility of the rays aimed at any of `sources` (the parts of one light, say),
+    /// as [`FieldCell::source_visibility`] gives it for one.
+    pub fn sources_visibility(&self, sources: Range<usize>) -> Option<f32> {
+        let counts = self.sources_counts(sources);
         (counts.traced > 0).then(|| texel_visibility(counts, self.visibility(), self.prior))
     }
 
     /// The counts of the rays aimed at `source` (zero where the field does not count it).
     pub fn source_counts(&self, source: usize) -> TexelCounts {
-        self.sources.get(source).copied().unwrap_or_default()
+        self.sources_counts(source..source + 1)
+    }
+
+    /// The counts of the rays aimed at any of `sources` (those the field counts).
+    pub fn sources_counts(&self, sources: Range<usize>) -> TexelCounts {
+        let mut total = TexelCounts::default();
+        for counts in self.sources.get(sources).unwrap_or_default() {
+            total.add(*counts);
+        }
+        total
     }
 
     /// The sum of what the rays that reached `source` brought, as the host recorded it
@@ -553,7 +569,12 @@ impl FieldCell<'_> {
     /// cell's sources these sums share one denominator (the cell's gathers), so their
     /// ratios estimate the sources' shares of the light the cell receives.
     pub fn source_brought(&self, source: usize) -> f64 {
-        self.brought.get(source).copied().unwrap_or(0.0)
+        self.sources_brought(source..source + 1)
+    }
+
+    /// What the rays that reached any of `sources` brought (summed in the sources' order).
+    pub fn sources_brought(&self, sources: Range<usize>) -> f64 {
+        self.brought.get(sources).unwrap_or_default().iter().sum()
     }
 
     /// The lowest visibility of the cell's texels.

@@ -369,7 +369,7 @@ fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> T
 /// What an accepted candidate brings, once its shadow ray is known ([`traced_value`]).
 fn value_of(run: &BatchRun, toward: &mut Toward, shadow_ray: ShadowRay) -> Traced {
     let at = run.at;
-    let source = run.world.lights.source_of(toward);
+    let source = run.world.lights.source_of(&at.receiver, toward);
     let nothing = |free| Traced {
         value: Vec3::ZERO,
         rating: 0.0,
@@ -433,7 +433,7 @@ fn trace(
         rating,
         // A ray was traced toward light only if it could bring some.
         free: (leaving.unoccluded != Vec3::ZERO).then_some(rating > 0.0),
-        source: run.world.lights.source_of(&toward),
+        source: run.world.lights.source_of(&at.receiver, &toward),
         parts: None,
     }
 }

@@ -58,14 +58,20 @@ pub fn field_rolls(settings: &GatherSettings) -> bool {
     settings.map_use.rolls() && settings.rays >= LEAST_ROLLING_RAYS
 }
 
-/// The lights whose rays the field counts per cell, to choose among them by what each
-/// brought: all of light sampling's choices where there are two or more, else none; none
-/// either beyond [`MOST_SOURCES`], where a cell could learn only some of them and the
-/// others would keep no more than the choice's defensive share.
+/// The sources the field counts per cell ([`crate::lights::Lights::field_sources`]), to
+/// choose among the lights and, within a sphere or a rectangle light, among the regions of
+/// its sample square by what each brought: all of them where there is a choice to make
+/// (two or more lights, or a light with regions), else none; none either beyond
+/// [`MOST_SOURCES`], where a cell could learn only some of them and the others would keep
+/// no more than the choice's defensive share.
 pub fn counted_sources(world: &World) -> usize {
-    match world.lights.source_count() {
-        count if (2..=MOST_SOURCES as usize).contains(&count) => count,
-        _ => 0,
+    let lights = &world.lights;
+    let sources = lights.field_sources();
+    let choice = lights.source_count() >= 2 || sources > lights.source_count();
+    if choice && sources <= MOST_SOURCES as usize {
+        sources
+    } else {
+        0
     }
 }
 
@@ -508,7 +514,8 @@ pub(super) fn field_gather<P: BatchProbe>(
         let guide = guides.guide(index, &cell);
         at.receiver.environment_guide = guide.environment.as_ref();
         at.receiver.light_choice = guide.lights.as_ref();
-        *field_guided += u64::from(guide.environment.is_some() || guide.lights.is_some());
+        at.receiver.region_choices = &guide.regions;
+        *field_guided += u64::from(guide.guides());
     }
     field_gathers[usize::from(rolling.is_none())] += 1;
     *gathers += 1;

@@ -7,6 +7,11 @@
 //! light. A light hidden from the cell, or far from it, is chosen less, a close one in view
 //! more; the choice's probabilities are exact, so nothing is biased.
 //!
+//! Within a sphere or a rectangle light, a cell weighs the 16 regions of the light's sample
+//! square ([`RegionChoice`]: 16 parts of the light as the cell sees it) by the same rule:
+//! through a door gap, the strip of a ceiling lamp that the cell sees gets the draws that
+//! the door would have blocked.
+//!
 //! In a cell whose texels the field knows, the environment is drawn from a defensive
 //! mixture of its own distribution and its exact product with the cell's texel
 //! visibilities ([`EnvironmentGuide`] on the field's octahedral texels): the sky that the
@@ -19,11 +24,14 @@
 //! field: every tile that meets the cell builds the same one (the image does not depend on
 //! the thread count). A tile keeps the guides of the cells it met.
 
-use crate::lights::{Environment, EnvironmentGuide, EnvironmentPartition, GuideLayout};
+use crate::lights::{
+    Environment, EnvironmentGuide, EnvironmentPartition, GuideLayout, RegionChoice, REGIONS,
+};
 use crate::world::World;
 use ais::field::{CellIndex, FieldCell, LEAST_EVIDENCE};
 use ais::sampling::AliasTable;
 use std::collections::HashMap;
+use std::ops::Range;
 use std::sync::Arc;
 
 /// A cell is guided only where fewer than this share of the environment's own draws would
@@ -55,6 +63,18 @@ pub struct CellGuide {
     pub environment: Option<EnvironmentGuide>,
     /// The choice among the lights by what the cell sees of them (`None`: by power).
     pub lights: Option<AliasTable>,
+    /// For each area light, the weighing of its sample square's regions by what they
+    /// brought the cell (`None`, or an empty list: drawn uniformly).
+    pub regions: Vec<Option<RegionChoice>>,
+}
+
+impl CellGuide {
+    /// Whether it changes light sampling at all.
+    pub fn guides(&self) -> bool {
+        self.environment.is_some()
+            || self.lights.is_some()
+            || self.regions.iter().any(Option::is_some)
+    }
 }
 
 /// A tile's guides, one per cell of the field it met.
@@ -63,8 +83,13 @@ pub struct FieldGuides {
     /// environment, or light sampling is not in the proposal).
     partition: Option<Arc<EnvironmentPartition>>,
     /// Light sampling's probabilities of choosing each light by power (empty: the field
-    /// does not choose among the lights).
+    /// counts no light's rays).
     power_choice: Vec<f64>,
+    /// The field's sources of each light (as light sampling orders them; empty where the
+    /// field counts no light's rays).
+    sources: Vec<Range<usize>>,
+    /// How many of the lights are area lights (the first ones).
+    area_lights: usize,
     by_cell: HashMap<CellIndex, CellGuide>,
     /// The guided share β of each mixture.
     fraction: f64,
@@ -84,14 +109,19 @@ impl FieldGuides {
             }
             _ => None,
         };
+        let lights = &world.lights;
         let counted = super::field::counted_sources(world) > 0 && samples_lights;
+        let (power_choice, sources) = if counted {
+            let sources = (0..lights.source_count()).map(|l| lights.sources_of_light(l));
+            (lights.power_choice(), sources.collect())
+        } else {
+            (Vec::new(), Vec::new())
+        };
         FieldGuides {
             partition,
-            power_choice: if counted {
-                world.lights.power_choice()
-            } else {
-                Vec::new()
-            },
+            power_choice,
+            sources,
+            area_lights: lights.area.len(),
             by_cell: HashMap::new(),
             fraction: fraction as f64,
         }
@@ -99,12 +129,15 @@ impl FieldGuides {
 
     /// The guide of the cell at `index`, built on first use.
     pub fn guide(&mut self, index: CellIndex, cell: &FieldCell) -> &CellGuide {
-        let (partition, power, fraction) = (&self.partition, &self.power_choice, self.fraction);
+        let (partition, fraction) = (&self.partition, self.fraction);
+        let (power, sources) = (&self.power_choice, &self.sources);
+        let area_sources = &sources[..self.area_lights.min(sources.len())];
         self.by_cell.entry(index).or_insert_with(|| CellGuide {
             environment: partition
                 .as_ref()
                 .and_then(|partition| build(partition, cell, fraction)),
-            lights: light_choice(power, cell, fraction),
+            lights: light_choice(power, sources, cell, fraction),
+            regions: region_choices(area_sources, cell, fraction),
         })
     }
 
@@ -119,6 +152,7 @@ impl FieldGuides {
                     .as_ref()
                     .map_or(0, EnvironmentGuide::memory_bytes)
                     + guide.lights.as_ref().map_or(0, light_choice)
+                    + guide.regions.capacity() * std::mem::size_of::<Option<RegionChoice>>()
             })
             .sum::<usize>()
             + self.by_cell.capacity() * std::mem::size_of::<(CellIndex, CellGuide)>()
@@ -128,32 +162,79 @@ impl FieldGuides {
 /// The choice among the lights in `cell`: each light's power share `power[l]` and, with
 /// share `fraction`, a share learned from what the cell's rays brought from each light,
 /// `B_l / √v_l` normalised (`B_l` the light's part of the cell's light, `v_l` the
-/// visibility of the rays aimed at it). That is the variance-optimal choice where a light's
-/// own sampling brings `B_l / v_l` through a free ray and nothing through a blocked one
-/// (docs/technique.md, "Choosing among lights"): a close light under a roof gets the draws a
-/// hidden sun would waste, though by power it is a hundredth of the sky. `None` where the
-/// field counts no lights, the cell has too little evidence, or no ray brought light.
-fn light_choice(power: &[f64], cell: &FieldCell, fraction: f64) -> Option<AliasTable> {
-    if power.is_empty() || cell.total().traced < LEAST_EVIDENCE {
+/// visibility of the rays aimed at it, over the light's field sources `sources[l]`). That is
+/// the variance-optimal choice where a light's own sampling brings `B_l / v_l` through a
+/// free ray and nothing through a blocked one (docs/technique.md, "Choosing among lights"):
+/// a close light under a roof gets the draws a hidden sun would waste, though by power it is
+/// a hundredth of the sky. `None` where there is one light or none to choose, the cell has
+/// too little evidence, or no ray brought light.
+fn light_choice(
+    power: &[f64],
+    sources: &[Range<usize>],
+    cell: &FieldCell,
+    fraction: f64,
+) -> Option<AliasTable> {
+    if power.len() < 2 || cell.total().traced < LEAST_EVIDENCE {
         return None;
     }
-    let visibility = cell.visibility();
-    let learned: Vec<f64> = (0..power.len())
-        .map(|light| {
-            let seen = cell.source_visibility(light).unwrap_or(visibility) as f64;
-            cell.source_brought(light) / seen.max(LEAST_SOURCE_VISIBILITY).sqrt()
-        })
-        .collect();
-    let total: f64 = learned.iter().sum();
-    if !(total > 0.0 && total.is_finite()) {
-        return None;
-    }
+    let learned = learned_shares(sources.iter().cloned(), cell, cell.visibility())?;
     let weights: Vec<f64> = power
         .iter()
         .zip(&learned)
-        .map(|(p, b)| (1.0 - fraction) * p + fraction * b / total)
+        .map(|(p, b)| (1.0 - fraction) * p + fraction * b)
         .collect();
     Some(AliasTable::new(&weights))
+}
+
+/// The shares `B_s / √v_s`, normalised, of the groups of sources `groups` in `cell`
+/// (`B_s` what the rays that reached the group brought, `v_s` their visibility, `seen`
+/// where no ray went); `None` where nothing was brought.
+fn learned_shares(
+    groups: impl Iterator<Item = Range<usize>>,
+    cell: &FieldCell,
+    seen: f32,
+) -> Option<Vec<f64>> {
+    let learned: Vec<f64> = groups
+        .map(|group| {
+            let visibility = cell.sources_visibility(group.clone()).unwrap_or(seen) as f64;
+            cell.sources_brought(group) / visibility.max(LEAST_SOURCE_VISIBILITY).sqrt()
+        })
+        .collect();
+    let total: f64 = learned.iter().sum();
+    (total > 0.0 && total.is_finite()).then(|| learned.iter().map(|b| b / total).collect())
+}
+
+/// For each area light whose rays the cell counts by region (`sources[l]`, one source per
+/// region), the weighing of the regions: `1 − fraction` spread evenly and `fraction` by
+/// their learned shares `B_k / √v_k`, the choice among lights' rule, which is
+/// variance-optimal here too, as a region is drawn by the light's own sampling restricted
+/// to it. `None` for a light with fewer than [`LEAST_EVIDENCE`] rays aimed at it or whose
+/// rays brought nothing; an empty list where no light has one.
+fn region_choices(
+    sources: &[Range<usize>],
+    cell: &FieldCell,
+    fraction: f64,
+) -> Vec<Option<RegionChoice>> {
+    let choices: Vec<Option<RegionChoice>> = sources
+        .iter()
+        .map(|light| {
+            if light.len() != REGIONS || cell.sources_counts(light.clone()).traced < LEAST_EVIDENCE
+            {
+                return None;
+            }
+            let seen = cell.sources_visibility(light.clone())?;
+            let regions = light.clone().map(|source| source..source + 1);
+            let learned = learned_shares(regions, cell, seen)?;
+            let weights: [f64; REGIONS] =
+                std::array::from_fn(|k| (1.0 - fraction) / REGIONS as f64 + fraction * learned[k]);
+            RegionChoice::new(&weights)
+        })
+        .collect();
+    if choices.iter().any(Option::is_some) {
+        choices
+    } else {
+        Vec::new()
+    }
 }
 
 /// The visibility below which a light's is not trusted to raise its choice further (a
@@ -231,7 +312,7 @@ mod tests {
         let (field, key) = cell_under_a_roof(true);
         let cell = field.cell(&key).unwrap();
         let power = [0.99, 0.01];
-        let choice = light_choice(&power, &cell, 0.75).expect("learned");
+        let choice = light_choice(&power, &[0..1, 1..2], &cell, 0.75).expect("learned");
         // The sky brought 0.2 through a tenth of its rays, the lamp 3 through all of
         // them: the learned shares are 0.2 / √0.1 against 3 / √1 (up to the prior).
         let lamp = choice.probability(1) as f64;
@@ -246,6 +327,6 @@ mod tests {
     fn a_cell_whose_rays_brought_nothing_chooses_by_power() {
         let (field, key) = cell_under_a_roof(false);
         let cell = field.cell(&key).unwrap();
-        assert!(light_choice(&[0.99, 0.01], &cell, 0.75).is_none());
+        assert!(light_choice(&[0.99, 0.01], &[0..1, 1..2], &cell, 0.75).is_none());
     }
 }
