@@ -369,7 +369,7 @@ fn print_gather_summary(
     let [rolled, aside] = rendered.output.stats.field_gathers;
     if settings.map == MapSource::Field && rolled + aside == 0 {
         println!(
-            "field        not used: no environment to guide, and roulette needs {LEAST_ROLLING_RAYS} rays per gather (rendered as AIS off)"
+            "field        not used: nothing to guide (no environment, and one light without regions), and roulette needs {LEAST_ROLLING_RAYS} rays per gather (rendered as AIS off)"
         );
     }
     if rolled + aside > 0 {
@@ -386,7 +386,8 @@ fn print_gather_summary(
             "MIS          BSDF share {share} (learned from the first passes; AIS off uses 0.5)"
         );
     }
-    if rendered.output.stats.field_stood_aside && rendered.output.stats.field_race.is_none() {
+    let stood_aside = rendered.output.stats.field_stood_aside;
+    if settings.map == MapSource::Field && stood_aside && rendered.output.stats.field_race.is_none() {
         println!("field        stood aside after its first passes: it found almost nothing to guide or roll, and the rest gathered as AIS off");
     }
     if let Some(race) = rendered.output.stats.field_race {
