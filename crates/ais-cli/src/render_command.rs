@@ -387,7 +387,8 @@ fn print_gather_summary(
         );
     }
     let stood_aside = rendered.output.stats.field_stood_aside;
-    if settings.map == MapSource::Field && stood_aside && rendered.output.stats.field_race.is_none() {
+    if settings.map == MapSource::Field && stood_aside && rendered.output.stats.field_race.is_none()
+    {
         println!("field        stood aside after its first passes: it found almost nothing to guide or roll, and the rest gathered as AIS off");
     }
     if let Some(race) = rendered.output.stats.field_race {

@@ -288,10 +288,16 @@ fn with_a_pinned_cost_ratio_the_rolling_field_does_not_race() {
 
 #[test]
 fn candidates_per_block_are_chosen_alike_at_any_thread_count_without_a_field() {
-    // A room lit by a rectangle light through a door gap: the field has no use at 16
-    // candidates, yet the race passes measure the pixels and the rest gathers as AIS off
-    // with the candidates per block they chose, from sample values only.
-    let world = common::shipped_scene_at("door_gap.xml", (48, 32));
+    // A room lit by a disk light through a door gap: the field has no use at 16
+    // candidates (one light, drawn by area: no regions to weigh), yet the race passes
+    // measure the pixels and the rest gathers as AIS off with the candidates per block
+    // they chose, from sample values only.
+    let scenes = common::shipped_scenes().expect("the shipped scenes");
+    let door_gap = std::fs::read_to_string(scenes.join("door_gap.xml")).unwrap();
+    let with_a_disk = door_gap.replace(r#"<shape type="rectangle">"#, r#"<shape type="disk">"#);
+    assert_ne!(with_a_disk, door_gap, "the light is a disk");
+    let mut world = common::scene_world("door_gap_disk", &with_a_disk, &[]);
+    world.set_resolution((48, 32));
     let auto = Integrator::Gather(GatherSettings::default());
     let one = on_threads_at(&world, 1, auto, 24);
     let two = on_threads_at(&world, 2, auto, 24);

@@ -373,15 +373,20 @@ mod tests {
         assert_eq!(square.solid_angle(Vec3::new(5.0, 0.0, 1.0)), 0.0);
     }
 
-    #[test]
-    fn samples_hit_the_rectangle() {
-        let r = Rectangle::new(
+    /// A rectangle tilted against the axes, emitting toward the origin's side.
+    fn tilted() -> Rectangle {
+        Rectangle::new(
             Vec3::new(0.2, -0.5, 2.0),
             Vec3::new(1.0, 0.0, 0.3),
             Vec3::new(0.0, 0.8, 0.0),
             true,
         )
-        .unwrap();
+        .unwrap()
+    }
+
+    #[test]
+    fn samples_hit_the_rectangle() {
+        let r = tilted();
         let mut rng = ais::rng::Pcg32::new(1, 1);
         let origin = Vec3::new(0.1, 0.1, 0.0);
         for _ in 0..1000 {
@@ -398,13 +403,7 @@ mod tests {
     #[test]
     fn the_inverse_map_finds_the_point_of_the_square_a_direction_was_drawn_from() {
         // A large view (drawn in f32) and a small one (in f64).
-        let r = Rectangle::new(
-            Vec3::new(0.2, -0.5, 2.0),
-            Vec3::new(1.0, 0.0, 0.3),
-            Vec3::new(0.0, 0.8, 0.0),
-            true,
-        )
-        .unwrap();
+        let r = tilted();
         let mut rng = ais::rng::Pcg32::new(4, 2);
         for origin in [Vec3::new(0.1, 0.1, 0.0), Vec3::new(30.0, -20.0, -40.0)] {
             let view = r.view(origin).unwrap();
