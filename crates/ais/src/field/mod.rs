@@ -1081,5 +1081,29 @@ mod tests {
         assert_eq!(cell.source_brought(5), 0.0);
         assert_eq!(field.cell(&other).unwrap().source_brought(0), 7.0);
         assert_eq!(field.cell(&other).unwrap().source_brought(1), 0.0);
+        // A range of sources (a light's regions) sums them; beyond the counted, nothing.
+        assert_eq!(cell.sources_brought(0..2), 3.75);
+        assert_eq!(cell.sources_brought(1..9), 0.0);
+    }
+
+    #[test]
+    fn a_range_of_sources_counts_the_rays_aimed_at_any_of_them() {
+        let key = CellKey::new([0.0; 3], [0.0, 0.0, 1.0], 0);
+        let mut observations = FieldObservations::new(4).with_sources(3);
+        let mut cell = observations.cell_mut(key);
+        for ray in 0..40 {
+            cell.record([0.0, 0.0, 1.0], ray % 2 == 0);
+            // Source 0 always free, 1 never, 2 unused.
+            cell.record_source(ray % 2, ray % 2 == 0);
+        }
+        let mut field = VisibilityField::new(4).with_sources(3).with_prior(0.0);
+        field.merge(&observations);
+        let cell = field.cell(&key).unwrap();
+        let both = cell.sources_counts(0..2);
+        assert_eq!((both.free, both.traced), (20, 40));
+        assert_eq!(cell.sources_visibility(0..2), Some(0.5));
+        assert_eq!(cell.sources_visibility(0..1), Some(1.0));
+        assert_eq!(cell.sources_visibility(2..3), None);
+        assert_eq!(cell.source_counts(1).free, 0);
     }
 }
