@@ -51,7 +51,7 @@ impl TexelCounts {
 
 /// The key of a cell: grid level (log2 of its spacing), integer coordinates at that level,
 /// and the dominant axis of the normal (0..6: ±x, ±y, ±z).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct CellKey {
     level: i8,
     face: u8,

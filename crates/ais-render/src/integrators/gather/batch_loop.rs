@@ -79,7 +79,7 @@ pub struct FieldUse<'a> {
 pub struct Lessons<'l, 'c> {
     /// The gather's cell in the pass's field observations.
     pub cell: Option<&'l mut CellRecorder<'c>>,
-    /// The pass's second moments per MIS share.
+    /// The pass's second moments per MIS share (the host ends each gather in them).
     pub shares: Option<&'l mut ShareMoments>,
     /// The gather's candidates as its estimate weighs them.
     pub spread: Option<&'l mut CandidateSpread>,
@@ -128,9 +128,6 @@ pub fn run_batch<P: BatchProbe>(
         run_one_by_one(run, batch, counts, probe, &mut lessons);
     }
     let estimate = batch.finish();
-    if let Some(shares) = lessons.shares {
-        shares.end_gather();
-    }
     if let Some(spread) = lessons.spread {
         spread.end_gather(estimate.candidates);
     }

@@ -11,6 +11,7 @@ use super::strategy::{GatherPoint, Strategy};
 use super::{batch_for, note_gather_variance, GatherSettings, GatherTile, MapSource};
 use crate::geometry::Hit;
 use crate::render::{Learning, PassEnd, RayCounts};
+use crate::texture::luminance;
 use crate::world::World;
 use ais::field::{CellIndex, CellKey, FieldCell, FieldObservations, VisibilityField, MOST_SOURCES};
 use ais::MapStart;
@@ -545,6 +546,9 @@ pub(super) fn field_gather<P: BatchProbe>(
         spread: spread.as_mut(),
     };
     let value = run_batch(&run, batch, counts, probe, lessons);
+    if let Some(shares) = shares.as_mut() {
+        shares.end_gather(site.key, luminance(value));
+    }
     note_gather_variance(race, spread);
     if let Some(started) = site.started {
         let after = batch.stats();

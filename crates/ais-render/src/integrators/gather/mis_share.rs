@@ -13,15 +13,21 @@
 //! (1 − c₀) / (1 − c))`, so the estimates are no heavier-tailed than the gathers
 //! themselves.
 //!
-//! A pass sums these over its gathers and the next pass uses the share with the least sum:
-//! the least summed variance of the gathers' estimates, the image's squared error in
-//! radiance. (relMSE weighs dark pixels more; weighing each gather by `1 / (E² + 0.01)`
-//! with `E` its own estimate, noisy as it is, chose a share that raised relMSE by a quarter
-//! behind a roof edge: the repository's BENCHMARKS.md, section 5.6.) A pass's share depends
-//! only on earlier passes, so every pass is unbiased, and the sums are added in tile order,
-//! so the choice does not depend on the thread count.
+//! A pass sums these per field cell (a patch of surface a few pixels wide), with the cell's
+//! gathers' mean estimate `Ē`, and the next pass uses the share with the least
+//! `Σ_cells M̂_cell(c) / (Ē_cell² + 0.01)`: the image's relMSE, which weighs each pixel's
+//! squared error by `1 / (r² + 0.01)`, with a cell's pixels alike. (Weighing by the squared
+//! error in radiance instead, every gather alike, lets the bright pixels choose: in a
+//! sunlit room the sun patch chose a share that raised relMSE by 12%. Weighing each
+//! gather by its own estimate `E`, noisy as it is, chose a share that raised relMSE by a
+//! quarter behind a roof edge: the repository's BENCHMARKS.md, section 5.6.) A pass's
+//! share depends only on earlier passes, so every pass is unbiased; the sums are added in
+//! tile order per cell and over the cells in their keys' order, so the choice does not
+//! depend on the thread count.
 
 use super::strategy::MisParts;
+use ais::field::CellKey;
+use std::collections::HashMap;
 
 /// The BSDF shares a render chooses among (the default,
 /// [`MIS_BSDF_WEIGHT`](super::strategy::MIS_BSDF_WEIGHT), among them).
@@ -31,15 +37,37 @@ pub const MIS_SHARES: [f64; 4] = [0.125, 0.25, 0.5, 0.75];
 /// stays.
 pub const LEAST_GATHERS: u64 = 500;
 
-/// The second moments of the gathers of a pass at every share of [`MIS_SHARES`].
+/// The second moments of the gathers of a pass at every share of [`MIS_SHARES`], per
+/// field cell.
 #[derive(Clone, Debug, Default)]
 pub struct ShareMoments {
-    /// Per share, the sum over the pass's gathers of their weighted moment estimates.
-    sums: [f64; MIS_SHARES.len()],
+    /// Per cell, its gathers' sums.
+    cells: HashMap<CellKey, CellMoments>,
     /// The current gather's sums per share.
     gather: [f64; MIS_SHARES.len()],
     /// Gathers with a candidate that brought light.
     gathers: u64,
+}
+
+/// One cell's gathers' sums.
+#[derive(Clone, Copy, Debug, Default)]
+struct CellMoments {
+    /// Per share, the sum of the gathers' moment estimates.
+    sums: [f64; MIS_SHARES.len()],
+    /// The sum of the gathers' estimates (luminance).
+    estimates: f64,
+    /// Its gathers.
+    gathers: u64,
+}
+
+impl CellMoments {
+    fn add(&mut self, other: &CellMoments) {
+        for (sum, other) in self.sums.iter_mut().zip(&other.sums) {
+            *sum += other;
+        }
+        self.estimates += other.estimates;
+        self.gathers += other.gathers;
+    }
 }
 
 impl ShareMoments {
@@ -57,37 +85,51 @@ impl ShareMoments {
         }
     }
 
-    /// Ends a gather: its sums join the pass's.
-    pub fn end_gather(&mut self) {
-        if self.gather.iter().all(|&sum| sum == 0.0) {
-            return;
-        }
-        for (sum, gather) in self.sums.iter_mut().zip(&mut self.gather) {
-            *sum += *gather;
-            *gather = 0.0;
-        }
-        self.gathers += 1;
+    /// Ends a gather in cell `cell` whose estimate (luminance) is `estimate`: its sums
+    /// join the cell's.
+    pub fn end_gather(&mut self, cell: CellKey, estimate: f32) {
+        let sums = std::mem::take(&mut self.gather);
+        let brought = sums.iter().any(|&sum| sum != 0.0);
+        self.gathers += u64::from(brought);
+        self.cells.entry(cell).or_default().add(&CellMoments {
+            sums,
+            estimates: estimate as f64,
+            gathers: 1,
+        });
     }
 
     /// Adds another tile's sums (tiles in order, so that the sums do not depend on the
     /// thread count).
     pub fn merge(&mut self, other: &ShareMoments) {
-        for (sum, other) in self.sums.iter_mut().zip(&other.sums) {
-            *sum += other;
+        for (key, cell) in &other.cells {
+            self.cells.entry(*key).or_default().add(cell);
         }
         self.gathers += other.gathers;
     }
 
-    /// The share with the least second moment, or `None` from fewer than
-    /// [`LEAST_GATHERS`] gathers.
+    /// The share with the least relMSE-weighted second moment, or `None` from fewer than
+    /// [`LEAST_GATHERS`] gathers with light.
     pub fn best(&self) -> Option<f64> {
         if self.gathers < LEAST_GATHERS {
             return None;
         }
-        let least = (0..MIS_SHARES.len()).min_by(|&a, &b| self.sums[a].total_cmp(&self.sums[b]));
+        let mut cells: Vec<(&CellKey, &CellMoments)> = self.cells.iter().collect();
+        cells.sort_unstable_by_key(|(key, _)| **key);
+        let mut weighted = [0.0; MIS_SHARES.len()];
+        for (_, cell) in cells {
+            let mean = cell.estimates / cell.gathers.max(1) as f64;
+            let weight = 1.0 / (mean * mean + RELATIVE_FLOOR);
+            for (total, sum) in weighted.iter_mut().zip(&cell.sums) {
+                *total += sum * weight;
+            }
+        }
+        let least = (0..MIS_SHARES.len()).min_by(|&a, &b| weighted[a].total_cmp(&weighted[b]));
         least.map(|k| MIS_SHARES[k])
     }
 }
+
+/// The floor under a cell's squared mean in its weight, relMSE's 0.01.
+const RELATIVE_FLOOR: f64 = 0.01;
 
 #[cfg(test)]
 mod tests {
@@ -113,8 +155,8 @@ mod tests {
             square += value * value;
             moments.add(value as f32, parts, share);
         }
-        moments.end_gather();
         let mean = sum / n as f64;
+        moments.end_gather(CellKey::new([0.0; 3], [0.0, 0.0, 1.0], 0), mean as f32);
         (square / n as f64 - mean * mean, moments)
     }
 
@@ -132,10 +174,11 @@ mod tests {
                 .min_by(|&a, &b| variances[a].total_cmp(&variances[b]))
                 .map(|k| MIS_SHARES[k]);
             // One gather of n candidates: the sums estimate n × M(c).
-            let mean_squared = |k: usize| moments.sums[k] / 200_000.0;
+            let cell = |m: &ShareMoments| *m.cells.values().next().unwrap();
+            let mean_squared = |k: usize| cell(&moments).sums[k] / 200_000.0;
             for (k, &share) in MIS_SHARES.iter().enumerate() {
                 let direct = variance_at(share, light_weight, &mut rng).1;
-                let own = direct.sums[k] / 200_000.0;
+                let own = cell(&direct).sums[k] / 200_000.0;
                 assert!(
                     (mean_squared(k) / own - 1.0).abs() < 0.02,
                     "share {share}: {} from share 0.5's draws, {own} from its own",
@@ -146,5 +189,26 @@ mod tests {
             enough.gathers = LEAST_GATHERS;
             assert_eq!(enough.best(), best, "light weight {light_weight}");
         }
+    }
+
+    #[test]
+    fn cells_weigh_as_relmse_weighs_their_pixels() {
+        // A bright cell's gathers vary least at share 0.75 and, in radiance, dominate; a
+        // dark cell's vary least at 0.125. relMSE weighs the dark cell's pixels 5000 times
+        // more: its share wins.
+        let mut moments = ShareMoments::default();
+        let bright = CellKey::new([0.0; 3], [0.0, 0.0, 1.0], 0);
+        let dark = CellKey::new([5.0, 0.0, 0.0], [0.0, 0.0, 1.0], 0);
+        for _ in 0..LEAST_GATHERS {
+            moments.gather = [200.0, 150.0, 100.0, 50.0];
+            moments.end_gather(bright, 10.0);
+            moments.gather = [0.01, 0.03, 0.06, 0.12];
+            moments.end_gather(dark, 0.1);
+        }
+        assert_eq!(moments.best(), Some(0.125));
+        let mut few = ShareMoments::default();
+        few.merge(&moments);
+        few.gathers = LEAST_GATHERS - 1;
+        assert_eq!(few.best(), None, "too few gathers with light");
     }
 }
