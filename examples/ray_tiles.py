@@ -83,7 +83,12 @@ def main() -> None:
     parser.add_argument("-o", "--output", default="tiles.exr", help="the merged image (EXR)")
     parser.add_argument("--spp", type=int, default=None)
     parser.add_argument("--rays", type=int, default=None)
-    parser.add_argument("--ais", default=None)
+    parser.add_argument(
+        "--ais",
+        default="off",
+        help="the AIS mode (off by default: `auto` learns its field from each tile's pixels, "
+        "so its tiles differ from a one-process render)",
+    )
     parser.add_argument("--tile", type=int, default=64, help="tile size in pixels")
     parser.add_argument("--address", default=None, help='a Ray cluster ("auto"), else local')
     args = parser.parse_args()
