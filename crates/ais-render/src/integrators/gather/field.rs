@@ -78,8 +78,9 @@ pub fn counted_sources(world: &World) -> usize {
 
 /// Whether the field can change anything in `world` with these settings (`map = field`):
 /// its roulette runs ([`field_rolls`]), or it can guide light sampling: toward an
-/// environment, or in the choice among two or more lights. Elsewhere (one area light, and
-/// fewer than [`LEAST_ROLLING_RAYS`] candidates) the gather renders as AIS off, nothing
+/// environment, in the choice among two or more lights, or among a sphere's or a
+/// rectangle's regions. Elsewhere (one disk, cylinder, mesh or delta light, and fewer than
+/// [`LEAST_ROLLING_RAYS`] candidates) the gather renders as AIS off, nothing
 /// recorded or timed: in one pass, or, where [`chooses_sizes`], in passes whose race
 /// passes measure the pixels.
 pub fn field_has_use(world: &World, settings: &GatherSettings) -> bool {
@@ -87,8 +88,8 @@ pub fn field_has_use(world: &World, settings: &GatherSettings) -> bool {
 }
 
 /// Whether the field can guide light sampling in `world` with these settings: light
-/// sampling is in the proposal, `map_use` guides, and there is an environment to draw or a
-/// choice among two or more lights.
+/// sampling is in the proposal, `map_use` guides, and there is an environment to draw, a
+/// choice among two or more lights, or a light with regions ([`counted_sources`]).
 pub fn field_can_guide(world: &World, settings: &GatherSettings) -> bool {
     let guidable = world.lights.environment.is_some() || counted_sources(world) > 0;
     settings.map_use.guides()
