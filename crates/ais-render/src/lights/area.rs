@@ -337,7 +337,7 @@ impl AreaLight {
                     .dot(b.as_dvec3())
                     .atan2(direction.dot(t.as_dvec3()));
                 let u1 = phi.rem_euclid(2.0 * PI) / (2.0 * PI);
-                Some([u0, u1].map(|c| (c as f32).clamp(0.0, 1.0 - f32::EPSILON / 2.0)))
+                Some([u0, u1].map(|c| (c as f32).clamp(0.0, super::ONE_BELOW)))
             }
             AreaShape::Rectangle(rectangle) => {
                 let view = receiver.rectangle_view(rectangle)?;

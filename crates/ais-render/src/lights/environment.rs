@@ -20,6 +20,7 @@
 //! [`fast_trig`], within 4e-7 rad of libm.
 
 use super::Toward;
+use super::ONE_BELOW;
 use crate::image_io::RgbImage;
 use ais::fast_trig;
 use ais::sampling::{uniform_sphere, CdfGrid};
@@ -278,9 +279,6 @@ fn cell_weights(image: &RgbImage, row_cosines: &[f64]) -> Vec<f64> {
     }
     weights
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 impl Environment {
     /// Radiance arriving from `direction` (unit, world space).

@@ -12,6 +12,7 @@
 //! follows the map, for the price of a short inversion and an alias draw, and no rejected
 //! candidate.
 
+use super::ONE_BELOW;
 use super::{Environment, EnvironmentMap, Toward};
 use ais::field::octahedral;
 use ais::mapping::LatLong;
@@ -236,9 +237,6 @@ impl EnvironmentPartition {
         }
     }
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// The partitions built for an environment, one per layout, shared by all threads. Cloning
 /// an environment starts an empty cache.

@@ -29,6 +29,9 @@ use ais::sampling::AliasTable;
 use glam::Vec3;
 use std::f64::consts::PI;
 
+/// The largest f32 below 1: a point of the unit interval clamped there stays inside it.
+const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
+
 /// The emitters of a scene.
 #[derive(Clone, Debug, Default)]
 pub struct Lights {

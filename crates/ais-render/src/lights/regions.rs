@@ -15,6 +15,8 @@
 //! inverting a cumulative table and rescaling the number within its interval, so draws
 //! that were stratified in `u` stay stratified.
 
+use super::ONE_BELOW;
+
 /// Regions along each side of the sample square.
 pub const REGION_SIDE: usize = 4;
 
@@ -84,9 +86,6 @@ impl RegionChoice {
         std::mem::size_of::<Self>()
     }
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Cumulative sums of `masses`, normalised so that the last is exactly 1.
 fn cumulative(masses: [f64; REGION_SIDE]) -> [f32; REGION_SIDE] {

@@ -3,6 +3,7 @@
 //! solid angle the rectangle subtends, so the density is 1 / solid angle, however close or
 //! oblique the rectangle is.
 
+use super::ONE_BELOW;
 use crate::geometry::Ray;
 use glam::{DVec3, Vec3};
 use std::f64::consts::PI;
@@ -216,9 +217,6 @@ impl<R: Real> Spherical<R> {
         [part / f(self.solid_angle), v].map(|c| (c as f32).clamp(0.0, ONE_BELOW))
     }
 }
-
-/// The largest f32 below 1.
-const ONE_BELOW: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// The interior angle of a spherical polygon between edges of inner normals `a` and `b`.
 fn angle_between(a: DVec3, b: DVec3) -> f64 {
