@@ -167,6 +167,12 @@ pub struct VisibilityField {
     planned: Option<f32>,
     /// Per cell, the share of its candidates roulette skips at the planned cost ratio.
     expected_rejection: Vec<f32>,
+    /// Per cell where roulette pays at the planned cost ratio, its texels' acceptances at
+    /// it, worked out once per pass instead of once per candidate (empty elsewhere).
+    acceptances: Vec<f32>,
+    /// Per cell, where its texels' acceptances start in `acceptances` (`u32::MAX`: not
+    /// worked out).
+    acceptances_at: Vec<u32>,
 }
 
 /// Texels per side of a cell's map by default: 64 texels of 0.2 sr each, for a host that
@@ -196,6 +202,8 @@ impl VisibilityField {
             darkest: Vec::new(),
             planned: None,
             expected_rejection: Vec::new(),
+            acceptances: Vec::new(),
+            acceptances_at: Vec::new(),
         }
     }
 
@@ -248,15 +256,18 @@ impl VisibilityField {
             + (self.counts.capacity() + self.totals.capacity()) * std::mem::size_of::<TexelCounts>()
             + (self.pooled.capacity()
                 + self.darkest.capacity()
-                + self.expected_rejection.capacity())
+                + self.expected_rejection.capacity()
+                + self.acceptances.capacity()
+                + self.acceptances_at.capacity())
                 * std::mem::size_of::<f32>()
             + self.brought.capacity() * std::mem::size_of::<f64>()
     }
 
     /// Works out, for every cell, the share of its candidates that roulette at `cost_ratio`
     /// would skip ([`FieldCell::expected_rejection`]), so that gathers can tell at once
-    /// whether roulette pays there. Call it once a pass's observations are merged, with
-    /// the cost ratio of the next pass; without it the share is worked out per lookup.
+    /// whether roulette pays there, and in the cells where it pays, every texel's
+    /// acceptance. Call it once a pass's observations are merged, with the cost ratio of
+    /// the next pass; without it both are worked out per lookup.
     pub fn plan(&mut self, cost_ratio: f32) {
         if self.planned == Some(cost_ratio) {
             return;
@@ -269,6 +280,30 @@ impl VisibilityField {
             })
             .collect();
         self.planned = Some(cost_ratio);
+        self.plan_acceptances(cost_ratio);
+    }
+
+    /// Works out the texels' acceptances at `cost_ratio` of the cells where roulette pays
+    /// at it (the planned ratio), as [`FieldCell::acceptance`] would per candidate.
+    fn plan_acceptances(&mut self, cost_ratio: f32) {
+        let texels = (self.side * self.side) as usize;
+        self.acceptances.clear();
+        self.acceptances_at = vec![u32::MAX; self.totals.len()];
+        for index in 0..self.totals.len() {
+            let cell = self.cell_at(CellIndex((index * self.stride()) as u32));
+            if !cell.worth_rolling(cost_ratio) {
+                continue;
+            }
+            let visibility = cell.visibility();
+            let planned: Vec<f32> = cell
+                .counts
+                .iter()
+                .map(|&counts| texel_acceptance(counts, visibility, self.prior, cost_ratio))
+                .collect();
+            self.acceptances_at[index] = self.acceptances.len() as u32;
+            self.acceptances.extend(planned);
+        }
+        debug_assert!(self.acceptances.len() <= self.totals.len() * texels);
     }
 
     /// After [`VisibilityField::plan`]: the share of the rays recorded so far whose cells
@@ -324,8 +359,20 @@ impl VisibilityField {
             planned: self
                 .planned
                 .map(|ratio| (ratio, self.expected_rejection[index])),
+            acceptances: self.planned_acceptances(index),
             side: self.side,
             prior: self.prior,
+        }
+    }
+
+    /// Cell `index`'s texels' acceptances at the planned cost ratio, if worked out.
+    fn planned_acceptances(&self, index: usize) -> &[f32] {
+        let texels = (self.side * self.side) as usize;
+        match self.acceptances_at.get(index) {
+            Some(&first) if first != u32::MAX && self.planned.is_some() => {
+                &self.acceptances[first as usize..first as usize + texels]
+            }
+            _ => &[],
         }
     }
 
@@ -353,6 +400,8 @@ impl VisibilityField {
         }
         if !touched.is_empty() {
             self.planned = None;
+            self.acceptances.clear();
+            self.acceptances_at.clear();
         }
         touched.sort_unstable();
         touched.dedup();
@@ -442,10 +491,7 @@ pub fn expected_rejection(
     let skipped: f32 = counts
         .iter()
         .filter(|c| c.traced > 0)
-        .map(|&c| {
-            let texel = texel_visibility(c, cell, prior);
-            c.traced as f32 * (1.0 - acceptance(texel, cell, cost_ratio))
-        })
+        .map(|&c| c.traced as f32 * (1.0 - texel_acceptance(c, cell, prior, cost_ratio)))
         .sum();
     skipped / total.traced as f32
 }
@@ -493,6 +539,12 @@ pub fn acceptance(texel: f32, cell: f32, cost_ratio: f32) -> f32 {
         .clamp(LOWEST_ACCEPTANCE, 1.0)
 }
 
+/// The [`acceptance`] of a texel of `counts` in a cell of visibility `cell`.
+#[inline]
+fn texel_acceptance(counts: TexelCounts, cell: f32, prior: f32, cost_ratio: f32) -> f32 {
+    acceptance(texel_visibility(counts, cell, prior), cell, cost_ratio)
+}
+
 /// One cell of the field, for the lookups of one gather.
 #[derive(Clone, Copy, Debug)]
 pub struct FieldCell<'a> {
@@ -508,6 +560,9 @@ pub struct FieldCell<'a> {
     darkest: f32,
     /// The planned cost ratio and this cell's expected rejection at it.
     planned: Option<(f32, f32)>,
+    /// Its texels' acceptances at the planned cost ratio, where roulette pays at it (else
+    /// empty).
+    acceptances: &'a [f32],
     side: u32,
     prior: f32,
 }
@@ -610,16 +665,21 @@ impl FieldCell<'_> {
         }
     }
 
-    /// [`acceptance`] toward `direction`.
+    /// [`acceptance`] toward `direction`: read from the field's plan where it was made at
+    /// this cost ratio and roulette pays here, else worked out (the same number).
     #[inline]
     pub fn acceptance(&self, direction: [f32; 3], cost_ratio: f32) -> f32 {
         // Once per candidate: this is the hot path of a rolling gather.
-        let cell = self.visibility();
-        acceptance(
-            texel_visibility(self.texel(direction), cell, self.prior),
-            cell,
-            cost_ratio,
-        )
+        let texel = octahedral::texel_of(direction, self.side);
+        match (self.planned, self.acceptances.get(texel)) {
+            (Some((ratio, _)), Some(&planned)) if ratio == cost_ratio => planned,
+            _ => texel_acceptance(
+                self.counts[texel],
+                self.visibility(),
+                self.prior,
+                cost_ratio,
+            ),
+        }
     }
 }
 
@@ -964,6 +1024,41 @@ mod tests {
         more.record(key, [0.0, 1.0, 0.0], true);
         field.merge(&more);
         assert_eq!(field.cell(&key).unwrap().planned, None);
+        assert!(field.cell(&key).unwrap().acceptances.is_empty());
+    }
+
+    #[test]
+    fn planned_acceptances_are_the_acceptances_worked_out() {
+        let key = CellKey::new([0.0; 3], [0.0, 1.0, 0.0], 0);
+        let mut observed = FieldObservations::new(8);
+        let mut rng = crate::rng::Pcg32::new(3, 9);
+        // Blocked below the horizon's band, free above, with some noise: many distinct
+        // texel counts.
+        for _ in 0..5000 {
+            let d = crate::sampling::uniform_sphere([rng.next_f32(), rng.next_f32()]);
+            let free = d.y > 0.5 || rng.next_f32() < 0.01;
+            observed.record(key, d.into(), free);
+        }
+        let mut field = VisibilityField::new(8);
+        field.merge(&observed);
+        let directions: Vec<[f32; 3]> = (0..2000)
+            .map(|_| crate::sampling::uniform_sphere([rng.next_f32(), rng.next_f32()]).into())
+            .collect();
+        let unplanned = field.cell(&key).unwrap();
+        let worked_out: Vec<f32> = directions
+            .iter()
+            .map(|&d| unplanned.acceptance(d, 1.0))
+            .collect();
+        field.plan(1.0);
+        let cell = field.cell(&key).unwrap();
+        assert!(cell.worth_rolling(1.0));
+        assert_eq!(cell.acceptances.len(), 64, "planned where roulette pays");
+        for (&d, expected) in directions.iter().zip(worked_out) {
+            assert_eq!(cell.acceptance(d, 1.0), expected, "toward {d:?}");
+        }
+        // Another cost ratio is worked out, not read from the plan.
+        let direct = texel_acceptance(cell.texel([0.0, -1.0, 0.0]), cell.visibility(), 2.0, 4.0);
+        assert_eq!(cell.acceptance([0.0, -1.0, 0.0], 4.0), direct);
     }
 
     #[test]
