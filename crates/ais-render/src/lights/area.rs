@@ -90,16 +90,49 @@ pub struct AreaLight {
 /// The cone of directions from `point` that a sphere subtends: its axis and the cosine of
 /// its half-angle (`None` from inside the sphere, where there is no cone).
 fn subtended_cone(sphere: &Sphere, point: Vec3) -> Option<(Vec3, f64)> {
-    let to_center = sphere.center - point;
-    let distance_squared = to_center.length_squared() as f64;
-    let r2 = (sphere.radius as f64).powi(2);
-    if distance_squared <= r2 {
-        return None;
+    let cone = SphereView::new(sphere, point)?;
+    Some((cone.axis, cone.cos_max))
+}
+
+/// A sphere seen from a point outside it: the cone it subtends, and how far its centre is.
+struct SphereView {
+    /// Toward the centre (unit).
+    axis: Vec3,
+    /// The cosine of the cone's half-angle.
+    cos_max: f64,
+    /// The squared distance to the centre.
+    distance_squared: f64,
+    /// The squared radius.
+    radius_squared: f64,
+}
+
+impl SphereView {
+    /// `sphere` seen from `point` (`None` from inside it).
+    #[inline]
+    fn new(sphere: &Sphere, point: Vec3) -> Option<Self> {
+        let to_center = sphere.center - point;
+        let distance_squared = to_center.length_squared() as f64;
+        let radius_squared = (sphere.radius as f64).powi(2);
+        if distance_squared <= radius_squared {
+            return None;
+        }
+        Some(SphereView {
+            axis: to_center.normalize(),
+            cos_max: (1.0 - radius_squared / distance_squared).max(0.0).sqrt(),
+            distance_squared,
+            radius_squared,
+        })
     }
-    Some((
-        to_center.normalize(),
-        (1.0 - r2 / distance_squared).max(0.0).sqrt(),
-    ))
+
+    /// How far the near side of the sphere is along a direction at `cos_theta` from the
+    /// axis (within the cone): the near root of the ray's quadratic, in closed form. At
+    /// the rim, where rounding puts the direction just outside, the tangent point.
+    #[inline]
+    fn distance_at(&self, cos_theta: f64) -> f64 {
+        let sin_squared = (1.0 - cos_theta * cos_theta).max(0.0);
+        let half_chord = (self.radius_squared - self.distance_squared * sin_squared).max(0.0);
+        self.distance_squared.sqrt() * cos_theta - half_chord.sqrt()
+    }
 }
 
 impl AreaLight {
@@ -178,24 +211,25 @@ impl AreaLight {
     pub fn sample_for(&self, receiver: &Receiver, u: [f32; 2]) -> Option<AreaSample> {
         let point = receiver.point;
         match &self.shape {
-            AreaShape::Sphere { sphere, .. } => {
-                let (axis, cos_max) = subtended_cone(sphere, point)?;
-                let cos_theta = 1.0 - u[0] as f64 * (1.0 - cos_max);
-                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let phi = 2.0 * PI * u[1] as f64;
-                let (t, b) = crate::geometry::basis(axis);
-                let direction = (t * (sin_theta * phi.cos()) as f32
-                    + b * (sin_theta * phi.sin()) as f32
-                    + axis * cos_theta as f32)
+            AreaShape::Sphere { sphere, flipped } => {
+                let cone = SphereView::new(sphere, point)?;
+                // The cone's angle in f64 (a small cone's 1 − cos θ is below f32's
+                // resolution at 1); the azimuth needs no more than f32.
+                let cos_theta = 1.0 - u[0] as f64 * (1.0 - cone.cos_max);
+                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt() as f32;
+                let (sin_phi, cos_phi) = (std::f32::consts::TAU * u[1]).sin_cos();
+                let (t, b) = crate::geometry::basis(cone.axis);
+                let direction = (t * (sin_theta * cos_phi)
+                    + b * (sin_theta * sin_phi)
+                    + cone.axis * cos_theta as f32)
                     .normalize();
-                // The point drawn is where the direction meets the sphere; at the rim, f32
-                // may miss it, and then nothing was drawn.
-                let hit = self.intersect(&Ray::new(point, direction))?;
+                let distance = cone.distance_at(cos_theta) as f32;
+                let outward = (point + direction * distance - sphere.center) / sphere.radius;
                 Some(AreaSample {
                     direction,
-                    pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
-                    distance: hit.distance,
-                    normal: hit.normal,
+                    pdf: 1.0 / (2.0 * PI * (1.0 - cone.cos_max)),
+                    distance,
+                    normal: if *flipped { -outward } else { outward },
                     spot: LightSpot::default(),
                 })
             }
