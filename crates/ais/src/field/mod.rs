@@ -286,24 +286,21 @@ impl VisibilityField {
     /// Works out the texels' acceptances at `cost_ratio` of the cells where roulette pays
     /// at it (the planned ratio), as [`FieldCell::acceptance`] would per candidate.
     fn plan_acceptances(&mut self, cost_ratio: f32) {
-        let texels = (self.side * self.side) as usize;
-        self.acceptances.clear();
-        self.acceptances_at = vec![u32::MAX; self.totals.len()];
-        for index in 0..self.totals.len() {
+        self.acceptances_at.clear();
+        let mut acceptances = Vec::new();
+        let mut starts = vec![u32::MAX; self.totals.len()];
+        for (index, start) in starts.iter_mut().enumerate() {
             let cell = self.cell_at(CellIndex((index * self.stride()) as u32));
-            if !cell.worth_rolling(cost_ratio) {
-                continue;
+            if cell.worth_rolling(cost_ratio) {
+                let visibility = cell.visibility();
+                *start = acceptances.len() as u32;
+                acceptances.extend(cell.counts.iter().map(|&counts| {
+                    texel_acceptance(counts, visibility, self.prior, cost_ratio)
+                }));
             }
-            let visibility = cell.visibility();
-            let planned: Vec<f32> = cell
-                .counts
-                .iter()
-                .map(|&counts| texel_acceptance(counts, visibility, self.prior, cost_ratio))
-                .collect();
-            self.acceptances_at[index] = self.acceptances.len() as u32;
-            self.acceptances.extend(planned);
         }
-        debug_assert!(self.acceptances.len() <= self.totals.len() * texels);
+        self.acceptances = acceptances;
+        self.acceptances_at = starts;
     }
 
     /// After [`VisibilityField::plan`]: the share of the rays recorded so far whose cells
