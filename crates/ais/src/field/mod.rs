@@ -294,9 +294,11 @@ impl VisibilityField {
             if cell.worth_rolling(cost_ratio) {
                 let visibility = cell.visibility();
                 *start = acceptances.len() as u32;
-                acceptances.extend(cell.counts.iter().map(|&counts| {
-                    texel_acceptance(counts, visibility, self.prior, cost_ratio)
-                }));
+                acceptances.extend(
+                    cell.counts.iter().map(|&counts| {
+                        texel_acceptance(counts, visibility, self.prior, cost_ratio)
+                    }),
+                );
             }
         }
         self.acceptances = acceptances;
