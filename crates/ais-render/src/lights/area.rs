@@ -87,14 +87,8 @@ pub struct AreaLight {
     pub shape_index: u32,
 }
 
-/// The cone of directions from `point` that a sphere subtends: its axis and the cosine of
-/// its half-angle (`None` from inside the sphere, where there is no cone).
-fn subtended_cone(sphere: &Sphere, point: Vec3) -> Option<(Vec3, f64)> {
-    let cone = SphereView::new(sphere, point)?;
-    Some((cone.axis, cone.cos_max))
-}
-
-/// A sphere seen from a point outside it: the cone it subtends, and how far its centre is.
+/// A sphere seen from a point outside it: the cone of directions it subtends, and how far
+/// its centre is.
 struct SphereView {
     /// Toward the centre (unit).
     axis: Vec3,
@@ -122,6 +116,12 @@ impl SphereView {
             distance_squared,
             radius_squared,
         })
+    }
+
+    /// The density of directions drawn uniformly in the cone, in solid angle.
+    #[inline]
+    fn density(&self) -> f64 {
+        1.0 / (2.0 * PI * (1.0 - self.cos_max))
     }
 
     /// How far the near side of the sphere is along a direction at `cos_theta` from the
@@ -227,7 +227,7 @@ impl AreaLight {
                 let outward = (point + direction * distance - sphere.center) / sphere.radius;
                 Some(AreaSample {
                     direction,
-                    pdf: 1.0 / (2.0 * PI * (1.0 - cone.cos_max)),
+                    pdf: cone.density(),
                     distance,
                     normal: if *flipped { -outward } else { outward },
                     spot: LightSpot::default(),
@@ -288,8 +288,9 @@ impl AreaLight {
         normal: Vec3,
     ) -> f64 {
         match &self.shape {
-            AreaShape::Sphere { sphere, .. } => subtended_cone(sphere, receiver.point)
-                .map_or(0.0, |(_, cos_max)| 1.0 / (2.0 * PI * (1.0 - cos_max))),
+            AreaShape::Sphere { sphere, .. } => {
+                SphereView::new(sphere, receiver.point).map_or(0.0, |cone| cone.density())
+            }
             AreaShape::Rectangle(rectangle) => {
                 1.0 / Rectangle::view_solid_angle(receiver.rectangle_view(rectangle))
             }
@@ -313,14 +314,14 @@ impl AreaLight {
         let point = receiver.point;
         match &self.shape {
             AreaShape::Sphere { sphere, .. } => {
-                let Some((_, cos_max)) = subtended_cone(sphere, point) else {
+                let Some(cone) = SphereView::new(sphere, point) else {
                     return 0.0;
                 };
                 // The support is decided by intersecting the sphere, as radiance is: a cone
                 // test in f32 disagrees with it at the rim, and a direction that brings
                 // light but has no light density gives a huge weight (seen at 17 radii).
                 if self.intersect(&Ray::new(point, direction)).is_some() {
-                    1.0 / (2.0 * PI * (1.0 - cos_max))
+                    cone.density()
                 } else {
                     0.0
                 }
@@ -363,10 +364,10 @@ impl AreaLight {
     ) -> Option<[f32; 2]> {
         match &self.shape {
             AreaShape::Sphere { sphere, .. } => {
-                let (axis, cos_max) = subtended_cone(sphere, receiver.point)?;
+                let cone = SphereView::new(sphere, receiver.point)?;
                 let direction = direction.as_dvec3();
-                let (t, b) = crate::geometry::basis(axis);
-                let u0 = (1.0 - direction.dot(axis.as_dvec3())) / (1.0 - cos_max);
+                let (t, b) = crate::geometry::basis(cone.axis);
+                let u0 = (1.0 - direction.dot(cone.axis.as_dvec3())) / (1.0 - cone.cos_max);
                 let phi = direction
                     .dot(b.as_dvec3())
                     .atan2(direction.dot(t.as_dvec3()));
