@@ -283,6 +283,10 @@ pub struct Batch<V: Value> {
     /// Each closed epoch's weight `n_e / n / candidates` (None: it drew no candidate).
     epoch_weights: [Option<f64>; MAX_EPOCHS],
     next_index: u32,
+    /// Numbers placed ahead by [`Batch::upcoming`]; those from `ahead_taken` on belong to
+    /// the next candidates, in order.
+    ahead: Vec<[f32; 3]>,
+    ahead_taken: usize,
     /// The current candidate's acceptance number u3.
     acceptance: f32,
     /// Candidates decided for tracing, in order; those from `recorded` on await their
@@ -340,6 +344,8 @@ impl<V: Value> Batch<V> {
             epoch_sums: [V::zero(); MAX_EPOCHS],
             epoch_weights: [None; MAX_EPOCHS],
             next_index: 0,
+            ahead: Vec::new(),
+            ahead_taken: 0,
             acceptance: 0.0,
             pending: Vec::new(),
             recorded: 0,
@@ -474,6 +480,8 @@ impl<V: Value> Batch<V> {
         self.epoch_candidates = 0;
         self.epoch_accepted = 0;
         self.next_index = 0;
+        self.ahead.clear();
+        self.ahead_taken = 0;
         let size = self.plan.sizes()[self.epoch];
         let cap = self.config.candidate_cap.saturating_mul(size);
         self.epoch_limit = match self.config.stopping {
@@ -506,13 +514,12 @@ impl<V: Value> Batch<V> {
     pub fn next_candidate(&mut self) -> Option<Candidate> {
         self.advance()?;
         let index = self.next_index - 1;
-        let [u1, u2, u3] = match self.config.placement {
-            Placement::Halton => self.halton.point(index),
-            Placement::Random => [
-                self.rng.next_f32(),
-                self.rng.next_f32(),
-                self.rng.next_f32(),
-            ],
+        let [u1, u2, u3] = match self.ahead.get(self.ahead_taken) {
+            Some(&point) => {
+                self.ahead_taken += 1;
+                point
+            }
+            None => self.place(index),
         };
         self.acceptance = u3;
         Some(Candidate { index, u: [u1, u2] })
@@ -529,11 +536,60 @@ impl<V: Value> Batch<V> {
     /// [decides ahead](Batch::decides_ahead).
     pub fn next_candidate_with(&mut self, u: [f32; 3]) -> Option<Candidate> {
         self.advance()?;
+        // Numbers placed ahead are not this candidate's: a later one must not take them.
+        self.ahead.clear();
+        self.ahead_taken = 0;
         self.acceptance = u[2];
         Some(Candidate {
             index: self.next_index - 1,
             u: [u[0], u[1]],
         })
+    }
+
+    /// The numbers of the next candidates, up to `points.len()` of them, without taking
+    /// them: each `[u1, u2, u3]` as [`Batch::next_candidate`] would place it, to be taken in
+    /// order with [`Batch::next_candidate_with`]. Returns how many were written: 0 when the
+    /// batch is complete, and none beyond the current epoch (where the next one starts
+    /// depends on the decisions before it). A host that [decides
+    /// ahead](Batch::decides_ahead) can so draw a run of candidates before deciding any, and
+    /// their draws overlap instead of waiting on one another.
+    ///
+    /// # Panics
+    /// If a candidate taken is not decided yet.
+    pub fn upcoming(&mut self, points: &mut [[f32; 3]]) -> usize {
+        assert!(
+            self.epoch_candidates == self.next_index,
+            "Batch::upcoming called before the last candidate was decided"
+        );
+        self.close_spent_epoch();
+        if self.done {
+            return 0;
+        }
+        if self.ahead_taken == self.ahead.len() {
+            self.ahead.clear();
+            self.ahead_taken = 0;
+        }
+        let count = ((self.epoch_limit - self.epoch_candidates) as usize).min(points.len());
+        let pending = self.ahead.len() - self.ahead_taken;
+        for k in pending..count {
+            let point = self.place(self.next_index + k as u32);
+            self.ahead.push(point);
+        }
+        points[..count].copy_from_slice(&self.ahead[self.ahead_taken..][..count]);
+        count
+    }
+
+    /// The numbers of candidate `index` of the epoch (for random placement, the next three
+    /// of the epoch's stream).
+    fn place(&mut self, index: u32) -> [f32; 3] {
+        match self.config.placement {
+            Placement::Halton => self.halton.point(index),
+            Placement::Random => [
+                self.rng.next_f32(),
+                self.rng.next_f32(),
+                self.rng.next_f32(),
+            ],
+        }
     }
 
     /// Moves to the next candidate (closing an epoch whose candidates are spent); `None`
@@ -543,6 +599,16 @@ impl<V: Value> Batch<V> {
             self.awaiting_record() == 0 || self.decides_ahead(),
             "Batch::record must follow a Decision::Trace before the next candidate"
         );
+        self.close_spent_epoch();
+        if self.done {
+            return None;
+        }
+        self.next_index += 1;
+        Some(())
+    }
+
+    /// Closes the current epoch if its candidates are spent.
+    fn close_spent_epoch(&mut self) {
         if !self.done && self.epoch_candidates >= self.epoch_limit {
             if !matches!(
                 self.config.stopping,
@@ -552,11 +618,6 @@ impl<V: Value> Batch<V> {
             }
             self.close_epoch();
         }
-        if self.done {
-            return None;
-        }
-        self.next_index += 1;
-        Some(())
     }
 
     /// Decides whether the current candidate, in `direction` (unit, in the map's frame; any
@@ -945,6 +1006,87 @@ mod tests {
                     );
                     assert_eq!(estimate.candidates, expected.candidates);
                     assert_eq!(estimate.traced, expected.traced);
+                }
+            }
+        }
+    }
+
+    /// Every candidate's numbers and decision, the candidates drawn `run` at a time through
+    /// [`Batch::upcoming`] (0: one at a time, without it).
+    fn placed_and_decided(batch: &mut Batch<f32>, n: u32, seed: u64, run: usize) -> Vec<u32> {
+        batch.begin(n, seed, MapStart::Current);
+        let mut seen = Vec::new();
+        let mut points = vec![[0.0; 3]; run.max(1)];
+        loop {
+            let count = if run > 0 {
+                batch.upcoming(&mut points)
+            } else {
+                1
+            };
+            for point in &points[..count.max(1)] {
+                let Some(candidate) = batch.next_candidate() else {
+                    assert!(
+                        run == 0 || count == 0,
+                        "upcoming promised a candidate that never came"
+                    );
+                    return seen;
+                };
+                if run > 0 {
+                    assert_eq!(candidate.u, [point[0], point[1]]);
+                }
+                let (direction, in_support, value) = test_candidate(candidate.u);
+                let decision = batch.decide(direction, in_support);
+                if let Decision::Trace { .. } = decision {
+                    batch.record(value, (value > 0.0) as u8 as f32);
+                }
+                let traced = matches!(decision, Decision::Trace { .. });
+                seen.extend(candidate.u.map(f32::to_bits));
+                seen.push(traced as u32);
+            }
+        }
+    }
+
+    #[test]
+    fn upcoming_numbers_are_those_the_candidates_get() {
+        let mut learner: Batch<f32> = Batch::new(BatchConfig {
+            affinity: Some(MapConfig::default()),
+            ..BatchConfig::default()
+        })
+        .unwrap();
+        drive(&mut learner, 256, 5, MapStart::Empty);
+        for placement in [Placement::Halton, Placement::Random] {
+            // One epoch; four epochs of a candidate budget; and those with roulette on a
+            // fixed map, where an epoch's end depends on the decisions before it.
+            let single = BatchConfig {
+                placement,
+                ..BatchConfig::off()
+            };
+            let budget = BatchConfig {
+                affinity: None,
+                learning: Learning::Off,
+                placement,
+                ..BatchConfig::default()
+            };
+            let mut fixed_map: Batch<f32> = Batch::new(BatchConfig {
+                affinity: Some(MapConfig::default()),
+                ..budget
+            })
+            .unwrap();
+            let learned = learner.map().unwrap();
+            fixed_map.map_mut().unwrap().copy_from(learned);
+            let templates = [
+                Batch::new(single).unwrap(),
+                Batch::new(budget).unwrap(),
+                fixed_map,
+            ];
+            for (which, template) in templates.iter().enumerate() {
+                for (n, seed) in [(16, 1), (37, 2)] {
+                    let expected = placed_and_decided(&mut template.clone(), n, seed, 0);
+                    assert!(expected.len() >= 3 * n as usize);
+                    for run in [1, 3, 16, 1000] {
+                        let seen = placed_and_decided(&mut template.clone(), n, seed, run);
+                        assert_eq!(seen, expected, "{placement:?}, batch {which}, n {n}, {run}");
+                    }
                 }
             }
         }

@@ -152,6 +152,7 @@ fn run_ahead(
     let mut drawn = [None; AHEAD];
     let mut weights = [1.0; AHEAD];
     let mut blocked = [None; AHEAD];
+    let mut arriving = [ShadowRay::Unneeded; AHEAD];
     loop {
         let count = draw_ahead(run, batch, &mut drawn, &mut weights);
         if count == 0 {
@@ -161,17 +162,23 @@ fn run_ahead(
         for (toward, blocked) in drawn[..count].iter_mut().flatten().zip(&mut blocked) {
             *blocked = trace_aimed(run.world, run.at, toward, counts);
         }
-        let traced = drawn[..count].iter_mut().flatten().zip(&blocked);
-        for ((toward, blocked), &weight) in traced.zip(&weights) {
-            let shadow_ray = radiance_if_free(run.world, run.at, toward, *blocked);
-            let traced = value_of(run, toward, shadow_ray);
+        // The free rays' radiance looked up for all of them first: the lookups overlap.
+        let looked_up = drawn[..count].iter_mut().flatten().zip(&blocked);
+        for ((toward, blocked), arriving) in looked_up.zip(&mut arriving) {
+            *arriving = radiance_if_free(run.world, run.at, toward, *blocked);
+        }
+        let traced = drawn[..count].iter_mut().flatten().zip(&arriving);
+        for ((toward, &arriving), &weight) in traced.zip(&weights) {
+            let traced = value_of(run, toward, arriving);
             record(run, batch, lessons, toward, &traced, weight);
         }
     }
 }
 
 /// Draws and decides candidates until [`AHEAD`] are to be traced or the batch is complete;
-/// returns how many were put in `drawn`, with their weights (1 / acceptance) in `weights`.
+/// returns how many were put in `drawn` (from its start, in the order decided), with their
+/// weights (1 / acceptance) in `weights`. The candidates the batch places next are drawn one
+/// after another before any is decided, so that one draw's table lookups overlap the next's.
 fn draw_ahead(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
@@ -181,24 +188,34 @@ fn draw_ahead(
     let at = run.at;
     // No value-aware rule runs here: the running mean stays unused.
     let mut values = RunningMean::default();
+    let mut points = [[0.0; 3]; AHEAD];
     let mut count = 0;
     while count < AHEAD {
-        let Some(candidate) = batch.next_candidate() else {
+        let placed = batch.upcoming(&mut points[..AHEAD - count]);
+        if placed == 0 {
             break;
-        };
-        // Drawn into its slot and decided there: a candidate is not copied on its way.
-        let slot = &mut drawn[count];
-        *slot = run.sampler.sample_direction(at, candidate.u);
-        let Some(toward) = slot else {
-            batch.decide(at.frame.normal, false);
-            continue;
-        };
-        let in_support = at.carries(toward);
-        let (decision, _) = decide(run, batch, &mut values, toward, in_support);
-        if let Decision::Trace { weight } = decision {
-            weights[count] = weight;
-            count += 1;
         }
+        // Drawn into their slots: a candidate is not copied on its way.
+        for (slot, point) in drawn[count..count + placed].iter_mut().zip(&points) {
+            *slot = run.sampler.sample_direction(at, [point[0], point[1]]);
+        }
+        let mut kept = count;
+        for k in count..count + placed {
+            let taken = batch.next_candidate();
+            debug_assert!(taken.is_some(), "the batch took back a candidate it placed");
+            let Some(toward) = &mut drawn[k] else {
+                batch.decide(at.frame.normal, false);
+                continue;
+            };
+            let in_support = at.carries(toward);
+            let (decision, _) = decide(run, batch, &mut values, toward, in_support);
+            if let Decision::Trace { weight } = decision {
+                weights[kept] = weight;
+                drawn.swap(kept, k);
+                kept += 1;
+            }
+        }
+        count = kept;
     }
     count
 }
