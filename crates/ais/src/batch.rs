@@ -963,14 +963,20 @@ mod tests {
         batch.finish()
     }
 
-    #[test]
-    fn deciding_ahead_gives_the_same_estimate_to_the_bit() {
+    /// A batch whose map learned from one gather of 256 candidates (a map to fix).
+    fn learned_batch() -> Batch<f32> {
         let mut learner: Batch<f32> = Batch::new(BatchConfig {
             affinity: Some(MapConfig::default()),
             ..BatchConfig::default()
         })
         .unwrap();
         drive(&mut learner, 256, 5, MapStart::Empty);
+        learner
+    }
+
+    #[test]
+    fn deciding_ahead_gives_the_same_estimate_to_the_bit() {
+        let learner = learned_batch();
         let mut fixed_map: Batch<f32> = Batch::new(BatchConfig {
             affinity: Some(MapConfig::default()),
             learning: Learning::Off,
@@ -1048,12 +1054,7 @@ mod tests {
 
     #[test]
     fn upcoming_numbers_are_those_the_candidates_get() {
-        let mut learner: Batch<f32> = Batch::new(BatchConfig {
-            affinity: Some(MapConfig::default()),
-            ..BatchConfig::default()
-        })
-        .unwrap();
-        drive(&mut learner, 256, 5, MapStart::Empty);
+        let learner = learned_batch();
         for placement in [Placement::Halton, Placement::Random] {
             // One epoch; four epochs of a candidate budget; and those with roulette on a
             // fixed map, where an epoch's end depends on the decisions before it.
