@@ -547,8 +547,8 @@ impl<V: Value> Batch<V> {
     }
 
     /// The numbers of the next candidates, up to `points.len()` of them, without taking
-    /// them: each `[u1, u2, u3]` as [`Batch::next_candidate`] would place it, to be taken in
-    /// order with [`Batch::next_candidate_with`]. Returns how many were written: 0 when the
+    /// them: each `[u1, u2, u3]` as [`Batch::next_candidate`] would place it; the next calls
+    /// of `next_candidate` take them, in order. Returns how many were written: 0 when the
     /// batch is complete, and none beyond the current epoch (where the next one starts
     /// depends on the decisions before it). A host that [decides
     /// ahead](Batch::decides_ahead) can so draw a run of candidates before deciding any, and
