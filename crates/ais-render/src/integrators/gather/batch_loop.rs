@@ -195,7 +195,7 @@ fn draw_ahead(
         if placed == 0 {
             break;
         }
-        // Drawn into their slots: a candidate is not copied on its way.
+        // Drawn into their slots (moved only to close the gap a rejected one leaves).
         for (slot, point) in drawn[count..count + placed].iter_mut().zip(&points) {
             *slot = run.sampler.sample_direction(at, [point[0], point[1]]);
         }
