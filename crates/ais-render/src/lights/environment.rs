@@ -225,13 +225,37 @@ impl EnvironmentMap {
     /// the fractions without a second trip through atan2.
     #[inline]
     pub(crate) fn toward_in_cell(&self, cell: usize, within: [f32; 2]) -> Toward {
-        let width = self.image.width;
-        self.toward_in_row_column(cell / width, cell % width, within)
+        let (row, column) = self.row_column(cell);
+        self.toward_in_row_column(row, column, within)
+    }
+
+    /// The first half of [`EnvironmentMap::sample`]: the row of cells that `u` draws, and
+    /// where `u` fell within its bin.
+    #[inline]
+    pub(super) fn sample_row(&self, u: f32) -> (usize, f32) {
+        self.cells.sample_row(u)
+    }
+
+    /// The second half: the column of `row` that `u` draws, and where it fell in its bin.
+    #[inline]
+    pub(super) fn sample_column(&self, row: usize, u: f32) -> (usize, f32) {
+        self.cells.sample_column(row, u)
+    }
+
+    /// The row and column of `cell` (row-major).
+    #[inline]
+    pub(super) fn row_column(&self, cell: usize) -> (usize, usize) {
+        (cell / self.image.width, cell % self.image.width)
     }
 
     /// [`EnvironmentMap::toward_in_cell`] for the cell at `row` and `column`.
     #[inline]
-    fn toward_in_row_column(&self, row: usize, column: usize, [fx, fy]: [f32; 2]) -> Toward {
+    pub(super) fn toward_in_row_column(
+        &self,
+        row: usize,
+        column: usize,
+        [fx, fy]: [f32; 2],
+    ) -> Toward {
         let width = self.image.width;
         let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
         let cos_theta = (top + fy * (bottom - top)).clamp(-1.0, 1.0);

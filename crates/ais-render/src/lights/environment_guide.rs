@@ -193,21 +193,8 @@ impl EnvironmentPartition {
     /// environment's own density there.
     fn sample_in_texel(&self, environment: &Environment, t: usize, v: f32, w: f32) -> Toward {
         match (&self.contents, environment) {
-            (
-                TexelContents::Cells {
-                    cells,
-                    start,
-                    within,
-                    within_guides,
-                    ..
-                },
-                Environment::Map(map),
-            ) => {
-                let first = start[t] as usize + t;
-                let count = (start[t + 1] - start[t]) as usize;
-                let guide = &within_guides[start[t] as usize..][..count];
-                let (i, fx) = invert_guided(&within[first..first + count + 1], guide, v as f64);
-                let cell = cells[start[t] as usize + i] as usize;
+            (TexelContents::Cells { .. }, Environment::Map(map)) => {
+                let (cell, fx) = self.cell_in_texel(t, v).expect("cells");
                 map.toward_in_cell(cell, [fx, w.min(ONE_BELOW)])
             }
             (TexelContents::Uniform { side }, _) => {
@@ -221,6 +208,34 @@ impl EnvironmentPartition {
             }
             (TexelContents::Cells { .. }, _) => environment.sample_toward([v, w]),
         }
+    }
+
+    /// Whether its texels hold an environment map's cells (else they hold uniform
+    /// directions).
+    pub(super) fn holds_cells(&self) -> bool {
+        matches!(self.contents, TexelContents::Cells { .. })
+    }
+
+    /// The environment cell of texel `t` that `v` ∈ [0, 1) draws, in proportion to the
+    /// cells' probabilities, and where `v` fell within the cell's bin (`None`: the texels
+    /// hold no cells, a constant environment's partition).
+    #[inline]
+    pub(super) fn cell_in_texel(&self, t: usize, v: f32) -> Option<(usize, f32)> {
+        let TexelContents::Cells {
+            cells,
+            start,
+            within,
+            within_guides,
+            ..
+        } = &self.contents
+        else {
+            return None;
+        };
+        let first = start[t] as usize + t;
+        let count = (start[t + 1] - start[t]) as usize;
+        let guide = &within_guides[start[t] as usize..][..count];
+        let (i, fx) = invert_guided(&within[first..first + count + 1], guide, v as f64);
+        Some((cells[start[t] as usize + i] as usize, fx))
     }
 
     /// The environment's own density at `toward` and the texel it lies in.
@@ -265,6 +280,15 @@ impl PartitionCache {
         built.push(partition.clone());
         partition
     }
+}
+
+/// Which half of a guide's mixture a draw takes ([`EnvironmentGuide::pick`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Pick {
+    /// The environment's own distribution, from this first number.
+    Own(f32),
+    /// The product: this texel, and where the number fell within its bin.
+    Texel(usize, f32),
 }
 
 /// The product distribution of one batch: a shared [`EnvironmentPartition`] and the
@@ -354,14 +378,28 @@ impl EnvironmentGuide {
 
     /// A direction from the mixture for `u` ∈ [0, 1)², located on the map.
     pub fn sample(&self, environment: &Environment, u: [f32; 2]) -> Toward {
+        match self.pick(u[0]) {
+            Pick::Own(u0) => environment.sample_toward([u0, u[1]]),
+            Pick::Texel(t, v) => self.partition.sample_in_texel(environment, t, v, u[1]),
+        }
+    }
+
+    /// The first step of [`EnvironmentGuide::sample`], from its first number `u0`.
+    #[inline]
+    pub(super) fn pick(&self, u0: f32) -> Pick {
         let beta = self.fraction;
-        let u0 = u[0] as f64;
+        let u0 = u0 as f64;
         if u0 >= beta {
             let rescaled = ((u0 - beta) / (1.0 - beta)).clamp(0.0, 1.0 - 1e-7);
-            return environment.sample_toward([rescaled as f32, u[1]]);
+            return Pick::Own(rescaled as f32);
         }
         let (t, v) = invert_guided(&self.cdf, &self.cdf_guide, u0 / beta);
-        self.partition.sample_in_texel(environment, t, v, u[1])
+        Pick::Texel(t, v)
+    }
+
+    /// The cells the texels hold ([`EnvironmentPartition::cell_in_texel`]).
+    pub(super) fn partition(&self) -> &EnvironmentPartition {
+        &self.partition
     }
 
     /// The mixture's density at a direction (solid angle).

@@ -5,6 +5,7 @@
 mod area;
 mod delta;
 mod environment;
+mod environment_draws;
 mod environment_guide;
 mod mesh_emitter;
 pub(crate) mod reader;
@@ -16,6 +17,7 @@ mod toward;
 pub use area::{AreaHit, AreaLight, AreaSample, AreaShape, LightSpot};
 pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use environment::{luminance, Environment, EnvironmentMap};
+pub use environment_draws::{Draw, EnvironmentDraws};
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout};
 pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
@@ -222,39 +224,73 @@ impl Lights {
     /// when it has one.
     #[inline]
     pub fn sample_toward(&self, receiver: &Receiver, u: [f32; 2]) -> Option<Toward> {
-        let choice = self.choice_for(receiver)?;
+        match self.begin_sample(receiver, u) {
+            Draw::Made(toward) => toward,
+            Draw::Environment(u) => self.environment_toward(receiver, u),
+        }
+    }
+
+    /// [`Lights::sample_toward`], except that a draw from an environment map is left to be
+    /// made together with other candidates' ([`EnvironmentDraws`]).
+    #[inline]
+    pub fn begin_sample(&self, receiver: &Receiver, u: [f32; 2]) -> Draw {
+        let Some(choice) = self.choice_for(receiver) else {
+            return Draw::Made(None);
+        };
         let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
-            let light = &self.area[index];
-            let square = [u0, u[1]];
-            // A receiver that weighs the light's regions draws the square's point from them.
-            let (square, region, factor) = match receiver.region_choice(index) {
-                Some(regions) => {
-                    let (square, region) = regions.sample(square);
-                    (square, region, regions.factor(region))
-                }
-                None => (square, region_of(square), 1.0),
-            };
-            let sample = light.sample_for(receiver, square)?;
-            let target = receiver.point + sample.direction * sample.distance;
-            let point = AreaPoint {
-                light: index,
-                target,
-                radiance: light.emitted(sample.normal, sample.direction, target, sample.spot),
-                density: choice.probability(index) as f64 * sample.pdf * factor,
-                region: Some(region as u8),
-            };
-            return Some(Toward::area(sample.direction, point));
+            let probability = choice.probability(index) as f64;
+            return Draw::Made(self.sample_area(receiver, index, probability, [u0, u[1]]));
         }
         if index < self.environment_index() {
             let delta = index - self.area.len();
-            let arrival = self.delta[delta].arrival(receiver.point)?;
-            return Some(Toward::delta(delta, arrival));
+            let arrival = self.delta[delta].arrival(receiver.point);
+            return Draw::Made(arrival.map(|arrival| Toward::delta(delta, arrival)));
         }
+        match self.environment {
+            Some(Environment::Map(_)) => Draw::Environment([u0, u[1]]),
+            _ => Draw::Made(self.environment_toward(receiver, [u0, u[1]])),
+        }
+    }
+
+    /// A point of area light `index` (chosen with `probability`) drawn from `square` for
+    /// `receiver`.
+    #[inline]
+    fn sample_area(
+        &self,
+        receiver: &Receiver,
+        index: usize,
+        probability: f64,
+        square: [f32; 2],
+    ) -> Option<Toward> {
+        let light = &self.area[index];
+        // A receiver that weighs the light's regions draws the square's point from them.
+        let (square, region, factor) = match receiver.region_choice(index) {
+            Some(regions) => {
+                let (square, region) = regions.sample(square);
+                (square, region, regions.factor(region))
+            }
+            None => (square, region_of(square), 1.0),
+        };
+        let sample = light.sample_for(receiver, square)?;
+        let target = receiver.point + sample.direction * sample.distance;
+        let point = AreaPoint {
+            light: index,
+            target,
+            radiance: light.emitted(sample.normal, sample.direction, target, sample.spot),
+            density: probability * sample.pdf * factor,
+            region: Some(region as u8),
+        };
+        Some(Toward::area(sample.direction, point))
+    }
+
+    /// The environment's direction from `u` (drawn by the receiver's guide when it has one).
+    #[inline]
+    fn environment_toward(&self, receiver: &Receiver, u: [f32; 2]) -> Option<Toward> {
         let environment = self.environment.as_ref()?;
         Some(match receiver.environment_guide {
-            Some(guide) => guide.sample(environment, [u0, u[1]]),
-            None => environment.sample_toward([u0, u[1]]),
+            Some(guide) => guide.sample(environment, u),
+            None => environment.sample_toward(u),
         })
     }
 

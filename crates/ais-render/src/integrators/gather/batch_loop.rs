@@ -8,7 +8,7 @@ use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, Shadow
 use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
 use super::strategy::{GatherPoint, MisParts};
-use crate::lights::{luminance, Toward};
+use crate::lights::{luminance, Draw, EnvironmentDraws, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
@@ -195,10 +195,19 @@ fn draw_ahead(
         if placed == 0 {
             break;
         }
-        // Drawn into their slots (moved only to close the gap a rejected one leaves).
-        for (slot, point) in drawn[count..count + placed].iter_mut().zip(&points) {
-            *slot = run.sampler.sample_direction(at, [point[0], point[1]]);
+        // Drawn into their slots (moved only to close the gap a rejected one leaves); the
+        // environment map's draws all together, step by step.
+        let mut environment = EnvironmentDraws::default();
+        for (k, point) in (count..count + placed).zip(&points) {
+            drawn[k] = match run.sampler.begin_direction(at, [point[0], point[1]]) {
+                Draw::Made(toward) => toward,
+                Draw::Environment(u) => {
+                    environment.push(k, u);
+                    None
+                }
+            };
         }
+        environment.draw(at.lights, &at.receiver, |k, toward| drawn[k] = Some(toward));
         let mut kept = count;
         for k in count..count + placed {
             let taken = batch.next_candidate();

@@ -17,7 +17,7 @@
 //! unbiased whatever the map says, and a wrong map costs at most `1 / (1 − α)` in variance.
 
 use super::strategy::{GatherPoint, MisParts, Strategy};
-use crate::lights::{Environment, EnvironmentGuide, Toward};
+use crate::lights::{Draw, Environment, EnvironmentGuide, Toward};
 use ais::mapping::LatLong;
 use ais::{AffinityMap, TexelDistribution};
 
@@ -60,15 +60,24 @@ impl<'a> CandidateSampler<'a> {
     /// A candidate direction from `u` ∈ [0, 1)² (`None`: the strategy gave none).
     #[inline]
     pub fn sample_direction(&self, at: &GatherPoint, u: [f32; 2]) -> Option<Toward> {
+        at.finish(self.begin_direction(at, u))
+    }
+
+    /// [`CandidateSampler::sample_direction`], except that a draw from an environment map
+    /// is left to be made together with other candidates' ([`EnvironmentDraws`]).
+    ///
+    /// [`EnvironmentDraws`]: crate::lights::EnvironmentDraws
+    #[inline]
+    pub fn begin_direction(&self, at: &GatherPoint, u: [f32; 2]) -> Draw {
         let Some(guide) = self.guide else {
-            return self.strategy.sample_direction(at, u);
+            return self.strategy.begin_direction(at, u);
         };
         let alpha = self.fraction;
         if u[0] < alpha {
-            Some(Toward::new(guide.sample([u[0] / alpha, u[1]])))
+            Draw::Made(Some(Toward::new(guide.sample([u[0] / alpha, u[1]]))))
         } else {
             let rescaled = ((u[0] - alpha) / (1.0 - alpha)).min(1.0 - 1e-7);
-            self.strategy.sample_direction(at, [rescaled, u[1]])
+            self.strategy.begin_direction(at, [rescaled, u[1]])
         }
     }
 

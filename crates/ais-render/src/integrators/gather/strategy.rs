@@ -3,7 +3,7 @@
 
 use crate::bsdf::{HitBsdf, ShadingFrame, SurfacePoint};
 use crate::geometry::Hit;
-use crate::lights::{Lights, Receiver, Toward};
+use crate::lights::{Draw, EnvironmentDraws, Lights, Receiver, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
@@ -108,6 +108,21 @@ impl GatherPoint<'_> {
         }
     }
 
+    /// The direction of a draw, made now if it was left for later.
+    #[inline]
+    pub fn finish(&self, draw: Draw) -> Option<Toward> {
+        match draw {
+            Draw::Made(toward) => toward,
+            Draw::Environment(u) => {
+                let mut draws = EnvironmentDraws::default();
+                draws.push(0, u);
+                let mut made = None;
+                draws.draw(self.lights, &self.receiver, |_, toward| made = Some(toward));
+                made
+            }
+        }
+    }
+
     /// A direction drawn from the BSDF (`None`: nothing scatters toward the viewer).
     #[inline]
     fn sample_bsdf(&self, u: [f32; 2]) -> Option<Toward> {
@@ -165,17 +180,26 @@ impl Strategy {
     /// carries its place there, for the density and the radiance.
     #[inline]
     pub fn sample_direction(self, at: &GatherPoint, u: [f32; 2]) -> Option<Toward> {
+        at.finish(self.begin_direction(at, u))
+    }
+
+    /// [`Strategy::sample_direction`], except that a draw from an environment map is left
+    /// to be made together with other candidates' ([`EnvironmentDraws`]).
+    ///
+    /// [`EnvironmentDraws`]: crate::lights::EnvironmentDraws
+    #[inline]
+    pub fn begin_direction(self, at: &GatherPoint, u: [f32; 2]) -> Draw {
         match self.effective(at) {
-            Strategy::Uniform => Some(Toward::new(uniform_sphere(u))),
-            Strategy::Bsdf => at.sample_bsdf(u),
-            Strategy::Light => at.lights.sample_toward(&at.receiver, u),
+            Strategy::Uniform => Draw::Made(Some(Toward::new(uniform_sphere(u)))),
+            Strategy::Bsdf => Draw::Made(at.sample_bsdf(u)),
+            Strategy::Light => at.lights.begin_sample(&at.receiver, u),
             Strategy::Mis => {
                 let w = at.mis_bsdf_share as f32;
                 if u[0] < w {
-                    at.sample_bsdf([u[0] / w, u[1]])
+                    Draw::Made(at.sample_bsdf([u[0] / w, u[1]]))
                 } else {
                     let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
-                    at.lights.sample_toward(&at.receiver, [u0, u[1]])
+                    at.lights.begin_sample(&at.receiver, [u0, u[1]])
                 }
             }
         }
