@@ -159,6 +159,9 @@ pub struct VisibilityField {
     brought: Vec<f64>,
     /// Per cell, the sum of its texels' counts.
     totals: Vec<TexelCounts>,
+    /// Per cell, the normals its hosts recorded (once per gather; summed in the order the
+    /// host merges its observations).
+    normals: Vec<NormalSum>,
     /// Per cell, its texels' visibilities pooled with their blocks' ([`pooling`]).
     pooled: Vec<f32>,
     /// Per cell, the lowest visibility of its texels.
@@ -198,6 +201,7 @@ impl VisibilityField {
             counts: Vec::new(),
             brought: Vec::new(),
             totals: Vec::new(),
+            normals: Vec::new(),
             pooled: Vec::new(),
             darkest: Vec::new(),
             planned: None,
@@ -261,6 +265,7 @@ impl VisibilityField {
                 + self.acceptances_at.capacity())
                 * std::mem::size_of::<f32>()
             + self.brought.capacity() * std::mem::size_of::<f64>()
+            + self.normals.capacity() * std::mem::size_of::<NormalSum>()
     }
 
     /// Works out, for every cell, the share of its candidates that roulette at `cost_ratio`
@@ -354,6 +359,7 @@ impl VisibilityField {
             sources: &self.counts[first + texels..first + self.stride()],
             brought: &self.brought[index * sources..(index + 1) * sources],
             total: self.totals[index],
+            normal: self.normals[index],
             darkest: self.darkest[index],
             planned: self
                 .planned
@@ -419,6 +425,7 @@ impl VisibilityField {
             self.brought
                 .resize(self.brought.len() + self.sources as usize, 0.0);
             self.totals.push(TexelCounts::default());
+            self.normals.push(NormalSum::default());
             self.pooled.resize(self.pooled.len() + texels, 1.0);
             self.darkest.push(1.0);
         }
@@ -433,6 +440,7 @@ impl VisibilityField {
         for (sum, &value) in brought.iter_mut().zip(seen.brought.iter()) {
             *sum += value;
         }
+        self.normals[index].add(seen.normal);
         index
     }
 
@@ -448,6 +456,45 @@ impl VisibilityField {
         self.pooled[index * texels..(index + 1) * texels].copy_from_slice(
             &pooling::pooled_visibilities(counts, self.side, cell, self.prior),
         );
+    }
+}
+
+/// The normals recorded in a cell: their sum and their number.
+#[derive(Clone, Copy, Debug, Default)]
+struct NormalSum {
+    sum: [f64; 3],
+    count: f64,
+}
+
+/// A cell's normals agree where their mean is at least this long (1: all the same). Below
+/// it (a cell across a fold or a sharp curve) the cell reports no normal.
+pub const AGREEING_NORMALS: f64 = 0.9;
+
+impl NormalSum {
+    /// Adds `other`'s normals.
+    fn add(&mut self, other: NormalSum) {
+        for (sum, value) in self.sum.iter_mut().zip(other.sum) {
+            *sum += value;
+        }
+        self.count += other.count;
+    }
+
+    /// Adds one normal (unit; a non-finite one is ignored).
+    fn record(&mut self, normal: [f32; 3]) {
+        if normal.iter().all(|c| c.is_finite()) {
+            self.add(NormalSum {
+                sum: normal.map(f64::from),
+                count: 1.0,
+            });
+        }
+    }
+
+    /// The direction of the mean normal, where the normals agree ([`AGREEING_NORMALS`]).
+    fn mean_direction(&self) -> Option<[f32; 3]> {
+        let [x, y, z] = self.sum;
+        let length = (x * x + y * y + z * z).sqrt();
+        (self.count > 0.0 && length >= AGREEING_NORMALS * self.count)
+            .then(|| self.sum.map(|c| (c / length) as f32))
     }
 }
 
@@ -555,6 +602,8 @@ pub struct FieldCell<'a> {
     /// What the rays that reached each source brought.
     brought: &'a [f64],
     total: TexelCounts,
+    /// The normals recorded in it.
+    normal: NormalSum,
     /// The lowest visibility of its texels.
     darkest: f32,
     /// The planned cost ratio and this cell's expected rejection at it.
@@ -631,6 +680,13 @@ impl FieldCell<'_> {
         self.brought.get(sources).unwrap_or_default().iter().sum()
     }
 
+    /// The mean of the normals recorded in the cell ([`CellRecorder::record_normal`]), as a
+    /// unit vector, if they agree: `None` where none was recorded or their mean is shorter
+    /// than [`AGREEING_NORMALS`] (the cell spans a fold or a sharp curve).
+    pub fn normal(&self) -> Option<[f32; 3]> {
+        self.normal.mean_direction()
+    }
+
     /// The lowest visibility of the cell's texels.
     pub fn darkest(&self) -> f32 {
         self.darkest
@@ -696,6 +752,7 @@ pub struct FieldObservations {
 struct CellSeen {
     counts: Box<[TexelCounts]>,
     brought: Box<[f64]>,
+    normal: NormalSum,
 }
 
 impl FieldObservations {
@@ -730,10 +787,12 @@ impl FieldObservations {
         let seen = self.cells.entry(key).or_insert_with(|| CellSeen {
             counts: vec![TexelCounts::default(); slots].into_boxed_slice(),
             brought: vec![0.0; sources].into_boxed_slice(),
+            normal: NormalSum::default(),
         });
         CellRecorder {
             counts: &mut seen.counts,
             brought: &mut seen.brought,
+            normal: &mut seen.normal,
             side: self.side,
         }
     }
@@ -763,10 +822,18 @@ impl FieldObservations {
 pub struct CellRecorder<'a> {
     counts: &'a mut [TexelCounts],
     brought: &'a mut [f64],
+    normal: &'a mut NormalSum,
     side: u32,
 }
 
 impl CellRecorder<'_> {
+    /// Records the normal (unit) of one gather in the cell: the cell's mean normal
+    /// ([`FieldCell::normal`]) lets a host weigh the cell's directions by their cosine.
+    #[inline]
+    pub fn record_normal(&mut self, normal: [f32; 3]) {
+        self.normal.record(normal);
+    }
+
     /// Records one traced ray toward `direction`: free or blocked.
     #[inline]
     pub fn record(&mut self, direction: [f32; 3], free: bool) {
@@ -808,6 +875,47 @@ fn count(counts: &mut TexelCounts, free: bool) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A cell's normal is the mean of those its gathers recorded, merged from every tile
+    /// in any split; normals that disagree (a fold) give none.
+    #[test]
+    fn a_cell_knows_the_mean_normal_of_its_gathers() {
+        let flat = CellKey::new([0.5; 3], [0.0, 1.0, 0.0], 0);
+        let fold = CellKey::new([4.5; 3], [0.0, 1.0, 0.0], 0);
+        let tilted = [0.6f32, 0.8, 0.0];
+        let mut field = VisibilityField::new(4);
+        for tile in 0..2 {
+            let mut observations = FieldObservations::new(4);
+            for gather in 0..3 {
+                let mut cell = observations.cell_mut(flat);
+                cell.record([0.0, 1.0, 0.0], true);
+                cell.record_normal(if (tile + gather) % 2 == 0 {
+                    [0.0, 1.0, 0.0]
+                } else {
+                    tilted
+                });
+                let mut cell = observations.cell_mut(fold);
+                cell.record([0.0, 1.0, 0.0], true);
+                cell.record_normal(if gather == 0 {
+                    [1.0, 0.0, 0.0]
+                } else {
+                    [0.0, 1.0, 0.0]
+                });
+            }
+            field.merge(&observations);
+        }
+        // Three of each normal: the mean (0.3, 0.9, 0) normalised.
+        let normal = field
+            .cell(&flat)
+            .and_then(|cell| cell.normal())
+            .expect("agreeing");
+        let length = (0.3f32 * 0.3 + 0.9 * 0.9).sqrt();
+        for (got, want) in normal.iter().zip([0.3 / length, 0.9 / length, 0.0]) {
+            assert!((got - want).abs() < 1e-6, "{normal:?}");
+        }
+        // Two of six at right angles: the mean is 0.75 long.
+        assert_eq!(field.cell(&fold).and_then(|cell| cell.normal()), None);
+    }
 
     #[test]
     fn merged_observations_are_found_by_cell_and_direction() {

@@ -541,6 +541,9 @@ pub(super) fn field_gather<P: BatchProbe>(
         .as_mut()
         .filter(|_| record)
         .map(|observations| observations.cell_mut(site.key));
+    if let Some(recorder) = recorder.as_mut() {
+        recorder.record_normal(at.frame.normal.into());
+    }
     let lessons = Lessons {
         cell: recorder.as_mut(),
         shares: shares.as_mut(),

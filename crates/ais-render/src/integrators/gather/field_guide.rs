@@ -28,8 +28,9 @@ use crate::lights::{
     Environment, EnvironmentGuide, EnvironmentPartition, GuideLayout, RegionChoice, REGIONS,
 };
 use crate::world::World;
-use ais::field::{CellIndex, FieldCell, LEAST_EVIDENCE};
+use ais::field::{octahedral, CellIndex, FieldCell, LEAST_EVIDENCE};
 use ais::sampling::AliasTable;
+use glam::Vec3;
 use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::Arc;
@@ -54,6 +55,10 @@ pub const FIELD_GUIDE_FRACTION: f32 = 0.75;
 /// (A rule from the expected variance gain, Σ P_t v_t / m_t against Σ P_t v_t, was tried:
 /// it guided about as many cells and lost 10% of the gain in the sunlit room.)
 pub const GUIDE_CONTRAST: f32 = 0.5;
+
+/// The least cosine weight of a texel in a cell's guide ([`texel_cosines`]). (0.1 gained
+/// more than 0.3 in the courtyard, 8% against 5% in relMSE at n = 16.)
+pub const LEAST_TEXEL_COSINE: f32 = 0.1;
 
 /// What guides light sampling in one cell of the field.
 #[derive(Default)]
@@ -282,8 +287,35 @@ fn build(
     let mut guide = EnvironmentGuide::new(partition.clone());
     guide.set_fraction(fraction);
     let unseen = UNSEEN_TEXEL_SHARE * visibility;
-    guide.set_affinities(|texel| cell.pooled_visibility_at(texel).unwrap_or(unseen));
+    let cosine = texel_cosines(cell);
+    guide.set_affinities(|texel| match cell.pooled_visibility_at(texel) {
+        Some(visibility) => visibility * cosine(texel, true),
+        None => unseen * cosine(texel, false),
+    });
     Some(guide)
+}
+
+/// The weights by which a cell's guide follows the cosine factor of the light its
+/// surfaces receive: the cosine between the cell's mean normal and a texel's centre, at
+/// least [`LEAST_TEXEL_COSINE`] (a texel across the horizon gets part of its light at
+/// steeper angles than its centre). Behind the surface, where the cell's rays went (`seen`:
+/// a surface that transmits) the cosine's absolute value; where they never went (a surface
+/// that only reflects, whose draws there are wasted) the least weight. 1 everywhere where
+/// the cell's normals disagree ([`FieldCell::normal`]).
+fn texel_cosines(cell: &FieldCell) -> impl Fn(usize, bool) -> f32 {
+    let side = cell.side();
+    let normal = cell.normal().map(Vec3::from);
+    move |texel, seen| {
+        let Some(normal) = normal else {
+            return 1.0;
+        };
+        let (row, column) = ((texel as u32 / side) as f32, (texel as u32 % side) as f32);
+        let centre =
+            octahedral::direction_of([(column + 0.5) / side as f32, (row + 0.5) / side as f32]);
+        let cosine = normal.dot(Vec3::from(centre).normalize());
+        let cosine = if seen { cosine.abs() } else { cosine };
+        cosine.max(LEAST_TEXEL_COSINE)
+    }
 }
 
 #[cfg(test)]
