@@ -14,9 +14,10 @@
 //!
 //! In a cell whose texels the field knows, the environment is drawn from a defensive
 //! mixture of its own distribution and its exact product with the cell's texel
-//! visibilities ([`EnvironmentGuide`] on the field's octahedral texels): the sky that the
-//! cell sees through a window gets the samples that the walls around it would have
-//! blocked. Nothing is rejected for it; every candidate weighs f / q with q the mixture's
+//! visibilities ([`EnvironmentGuide`] on the field's octahedral texels), each times the
+//! cosine between the cell's mean normal and the texel: the sky that the cell sees through
+//! a window gets the samples that the walls around it would have blocked, and more of them
+//! where it shines on the surface more steeply. Nothing is rejected for it; every candidate weighs f / q with q the mixture's
 //! density, so the estimate stays exactly unbiased whatever the field says, and a field
 //! that wrongly calls a bright direction blocked costs at most 1 / (1 − β) in variance.
 //!
