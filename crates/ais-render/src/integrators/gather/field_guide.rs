@@ -57,9 +57,14 @@ pub const FIELD_GUIDE_FRACTION: f32 = 0.75;
 /// it guided about as many cells and lost 10% of the gain in the sunlit room.)
 pub const GUIDE_CONTRAST: f32 = 0.5;
 
-/// The least cosine weight of a texel in a cell's guide ([`texel_cosines`]). (0.1 gained
-/// more than 0.3 in the courtyard, 8% against 5% in relMSE at n = 16.)
+/// The least cosine weight of a texel in a cell's guide (a texel across the horizon gets
+/// part of its light more steeply than at its centre). (0.1 gained more than 0.3 in the
+/// courtyard, 8% against 5% in relMSE at n = 16.)
 pub const LEAST_TEXEL_COSINE: f32 = 0.1;
+
+/// A texel whose centre lies less than this cosine below a cell's horizon may still hold
+/// directions above it (a texel of a 16 × 16 map spans about 11°).
+pub const HORIZON_SLACK: f32 = 0.2;
 
 /// What guides light sampling in one cell of the field.
 #[derive(Default)]
@@ -285,37 +290,53 @@ fn build(
     if free_draws >= MOST_FREE_DRAWS {
         return None;
     }
-    let mut guide = EnvironmentGuide::new(partition.clone());
-    guide.set_fraction(fraction);
     let unseen = UNSEEN_TEXEL_SHARE * visibility;
     let cosine = texel_cosines(cell);
-    guide.set_affinities(|texel| match cell.pooled_visibility_at(texel) {
-        Some(visibility) => visibility * cosine(texel, true),
-        None => unseen * cosine(texel, false),
+    let seen = |texel| cell.pooled_visibility_at(texel).is_some();
+    // A_t: the learned visibility times the cosine.
+    let product: Vec<f64> = (0..texels)
+        .map(
+            |texel| match (cell.pooled_visibility_at(texel), cosine(texel)) {
+                (Some(visibility), Some(c)) => visibility * c.abs().max(LEAST_TEXEL_COSINE),
+                (None, Some(c)) => unseen * c.max(LEAST_TEXEL_COSINE),
+                (visibility, None) => visibility.unwrap_or(unseen),
+            } as f64,
+        )
+        .collect();
+    // H_t: 1 wherever light may come from, the least share behind a surface that only
+    // reflects (no ray of the cell went there).
+    let defensive: Vec<f64> = (0..texels)
+        .map(|texel| match cosine(texel) {
+            Some(c) if !seen(texel) && c < -HORIZON_SLACK => UNSEEN_TEXEL_SHARE as f64,
+            _ => 1.0,
+        })
+        .collect();
+    // The mixture `(1 − β) p_env H_t + β p_env A_t / Z_A`, renormalised, is itself a
+    // product of the environment with per-texel weights: drawn as one. Draws that H_t takes
+    // away from behind the surface go to both parts in proportion, and the defensive part
+    // keeps at least (1 − β) of the environment's density wherever H_t = 1.
+    let product_mass: f64 = (0..texels)
+        .map(|t| partition.texel_mass(t) * product[t])
+        .sum();
+    let mut guide = EnvironmentGuide::new(partition.clone());
+    guide.set_fraction(1.0);
+    guide.set_affinities(|texel| {
+        ((1.0 - fraction) * defensive[texel]
+            + fraction * product[texel] / product_mass.max(f64::MIN_POSITIVE)) as f32
     });
     Some(guide)
 }
 
-/// The weights by which a cell's guide follows the cosine factor of the light its
-/// surfaces receive: the cosine between the cell's mean normal and a texel's centre, at
-/// least [`LEAST_TEXEL_COSINE`] (a texel across the horizon gets part of its light at
-/// steeper angles than its centre). Behind the surface, where the cell's rays went (`seen`:
-/// a surface that transmits) the cosine's absolute value; where they never went (a surface
-/// that only reflects, whose draws there are wasted) the least weight. 1 everywhere where
-/// the cell's normals disagree ([`FieldCell::normal`]).
-fn texel_cosines(cell: &FieldCell) -> impl Fn(usize, bool) -> f32 {
+/// The cosine between the cell's mean normal and each texel's centre (`None` where the
+/// cell's normals disagree: [`FieldCell::normal`]).
+fn texel_cosines(cell: &FieldCell) -> impl Fn(usize) -> Option<f32> {
     let side = cell.side();
     let normal = cell.normal().map(Vec3::from);
-    move |texel, seen| {
-        let Some(normal) = normal else {
-            return 1.0;
-        };
+    move |texel| {
         let (row, column) = ((texel as u32 / side) as f32, (texel as u32 % side) as f32);
         let centre =
             octahedral::direction_of([(column + 0.5) / side as f32, (row + 0.5) / side as f32]);
-        let cosine = normal.dot(Vec3::from(centre).normalize());
-        let cosine = if seen { cosine.abs() } else { cosine };
-        cosine.max(LEAST_TEXEL_COSINE)
+        Some(normal?.dot(Vec3::from(centre).normalize()))
     }
 }
 
