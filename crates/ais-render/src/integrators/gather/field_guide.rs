@@ -36,12 +36,14 @@ use std::collections::HashMap;
 use std::ops::Range;
 use std::sync::Arc;
 
-/// A cell is guided only where fewer than this share of the environment's own draws would
-/// be free (Σ P_t v_t, texels whose block no ray went to counting as blocked): where most
-/// are free (open ground, a sculpture under the sky), guiding saves little variance, makes
-/// its rays dearer (free rays cross the scene) and, where a bright light is partly hidden
-/// within a texel, adds variance. Measured on the default scene: guided everywhere it had contrast,
-/// auto took 34% more time for 11% more relMSE.
+/// A cell whose normals disagree (so that its guide cannot follow the cosine) is guided
+/// only where fewer than this share of the environment's own draws would be free (Σ P_t
+/// v_t, texels whose block no ray went to counting as blocked): where most are free, a
+/// guide of visibilities alone saves little variance and makes its rays dearer (free rays
+/// cross the scene). Measured on the default scene before guides followed the cosine:
+/// guided everywhere it had contrast, auto took 34% more time for 11% more relMSE. With the
+/// cosine, guiding every cell that knows its normal gained at equal time in every sky-lit
+/// scene but the foliage (the repository's BENCHMARKS.md, section 5.6).
 pub const MOST_FREE_DRAWS: f64 = 0.5;
 
 /// The product's default share β of the environment's draws in a guided cell: a field that
@@ -50,11 +52,11 @@ pub const MOST_FREE_DRAWS: f64 = 0.5;
 /// and lost 3% more behind a roof edge: the repository's BENCHMARKS.md, section 5.6.)
 pub const FIELD_GUIDE_FRACTION: f32 = 0.75;
 
-/// A cell is guided only where its darkest texel is below this share of the cell's
-/// visibility: elsewhere the product is close to the environment's own distribution.
-/// (Besides, see [`MOST_FREE_DRAWS`].)
-/// (A rule from the expected variance gain, Σ P_t v_t / m_t against Σ P_t v_t, was tried:
-/// it guided about as many cells and lost 10% of the gain in the sunlit room.)
+/// A cell whose normals disagree is guided only where its darkest texel is below this
+/// share of the cell's visibility: elsewhere the product is close to the environment's own
+/// distribution (besides, see [`MOST_FREE_DRAWS`]). (A rule from the expected variance
+/// gain, Σ P_t v_t / m_t against Σ P_t v_t, was tried: it guided about as many cells and
+/// lost 10% of the gain in the sunlit room.)
 pub const GUIDE_CONTRAST: f32 = 0.5;
 
 /// The least cosine weight of a texel in a cell's guide (a texel across the horizon gets
@@ -279,17 +281,15 @@ fn build(
     cell: &FieldCell,
     fraction: f64,
 ) -> Option<EnvironmentGuide> {
-    let visibility = cell.visibility();
-    if cell.total().traced < LEAST_EVIDENCE || cell.darkest() >= GUIDE_CONTRAST * visibility {
+    if cell.total().traced < LEAST_EVIDENCE {
         return None;
     }
-    let texels = (cell.side() * cell.side()) as usize;
-    let free_draws: f64 = (0..texels)
-        .map(|t| partition.texel_mass(t) * cell.pooled_visibility_at(t).unwrap_or(0.0) as f64)
-        .sum();
-    if free_draws >= MOST_FREE_DRAWS {
+    // The cosine alone makes a guide worth drawing from: it follows the integrand's cosine
+    // wherever the sky lies. Without it, only the visibility's contrast can.
+    if cell.normal().is_none() && !contrast_worth_guiding(partition, cell) {
         return None;
     }
+    let (texels, visibility) = ((cell.side() * cell.side()) as usize, cell.visibility());
     let unseen = UNSEEN_TEXEL_SHARE * visibility;
     let cosine = texel_cosines(cell);
     let seen = |texel| cell.pooled_visibility_at(texel).is_some();
@@ -325,6 +325,17 @@ fn build(
             + fraction * product[texel] / product_mass.max(f64::MIN_POSITIVE)) as f32
     });
     Some(guide)
+}
+
+/// Whether a cell's visibilities alone make a guide worth it: its darkest texel is below
+/// [`GUIDE_CONTRAST`] of its visibility, and fewer than [`MOST_FREE_DRAWS`] of the
+/// environment's own draws would be free.
+fn contrast_worth_guiding(partition: &EnvironmentPartition, cell: &FieldCell) -> bool {
+    let texels = (cell.side() * cell.side()) as usize;
+    let free_draws: f64 = (0..texels)
+        .map(|t| partition.texel_mass(t) * cell.pooled_visibility_at(t).unwrap_or(0.0) as f64)
+        .sum();
+    cell.darkest() < GUIDE_CONTRAST * cell.visibility() && free_draws < MOST_FREE_DRAWS
 }
 
 /// The cosine between the cell's mean normal and each texel's centre (`None` where the
