@@ -13,13 +13,15 @@
 //! the door would have blocked.
 //!
 //! In a cell whose texels the field knows, the environment is drawn from a defensive
-//! mixture of its own distribution and its exact product with the cell's texel
+//! mixture of its own distribution (in front of the surface, where the cell knows its
+//! normal) and its exact product with the cell's texel
 //! visibilities ([`EnvironmentGuide`] on the field's octahedral texels), each times the
 //! cosine between the cell's mean normal and the texel: the sky that the cell sees through
 //! a window gets the samples that the walls around it would have blocked, and more of them
-//! where it shines on the surface more steeply. Nothing is rejected for it; every candidate weighs f / q with q the mixture's
-//! density, so the estimate stays exactly unbiased whatever the field says, and a field
-//! that wrongly calls a bright direction blocked costs at most 1 / (1 − β) in variance.
+//! where it shines on the surface more steeply. Nothing is rejected for it; every candidate
+//! weighs f / q with q the mixture's density, so the estimate stays exactly unbiased
+//! whatever the field says, and a field that wrongly calls a bright direction blocked costs
+//! at most 1 / (1 − β) in variance.
 //!
 //! The field is fixed during a pass, so the guide of a cell depends on nothing but the
 //! field: every tile that meets the cell builds the same one (the image does not depend on
@@ -289,33 +291,12 @@ fn build(
     if cell.normal().is_none() && !contrast_worth_guiding(partition, cell) {
         return None;
     }
-    let (texels, visibility) = ((cell.side() * cell.side()) as usize, cell.visibility());
-    let unseen = UNSEEN_TEXEL_SHARE * visibility;
-    let cosine = texel_cosines(cell);
-    let seen = |texel| cell.pooled_visibility_at(texel).is_some();
-    // A_t: the learned visibility times the cosine.
-    let product: Vec<f64> = (0..texels)
-        .map(
-            |texel| match (cell.pooled_visibility_at(texel), cosine(texel)) {
-                (Some(visibility), Some(c)) => visibility * c.abs().max(LEAST_TEXEL_COSINE),
-                (None, Some(c)) => unseen * c.max(LEAST_TEXEL_COSINE),
-                (visibility, None) => visibility.unwrap_or(unseen),
-            } as f64,
-        )
-        .collect();
-    // H_t: 1 wherever light may come from, the least share behind a surface that only
-    // reflects (no ray of the cell went there).
-    let defensive: Vec<f64> = (0..texels)
-        .map(|texel| match cosine(texel) {
-            Some(c) if !seen(texel) && c < -HORIZON_SLACK => UNSEEN_TEXEL_SHARE as f64,
-            _ => 1.0,
-        })
-        .collect();
+    let (product, defensive) = (product_weights(cell), defensive_weights(cell));
     // The mixture `(1 − β) p_env H_t + β p_env A_t / Z_A`, renormalised, is itself a
     // product of the environment with per-texel weights: drawn as one. Draws that H_t takes
     // away from behind the surface go to both parts in proportion, and the defensive part
     // keeps at least (1 − β) of the environment's density wherever H_t = 1.
-    let product_mass: f64 = (0..texels)
+    let product_mass: f64 = (0..product.len())
         .map(|t| partition.texel_mass(t) * product[t])
         .sum();
     let mut guide = EnvironmentGuide::new(partition.clone());
@@ -325,6 +306,43 @@ fn build(
             + fraction * product[texel] / product_mass.max(f64::MIN_POSITIVE)) as f32
     });
     Some(guide)
+}
+
+/// `A_t`, the product's weight of each texel of `cell`: its learned visibility, pooled
+/// with its neighbours' (texels whose block no ray of the cell went to: a hundredth of the
+/// cell's, [`UNSEEN_TEXEL_SHARE`]), times the cosine to the cell's normal where it knows
+/// one (at least [`LEAST_TEXEL_COSINE`]; behind the surface, its absolute value where rays
+/// went, as through a surface that transmits).
+fn product_weights(cell: &FieldCell) -> Vec<f64> {
+    let texels = (cell.side() * cell.side()) as usize;
+    let unseen = UNSEEN_TEXEL_SHARE * cell.visibility();
+    let cosine = texel_cosines(cell);
+    (0..texels)
+        .map(|texel| {
+            let weight = match (cell.pooled_visibility_at(texel), cosine(texel)) {
+                (Some(visibility), Some(c)) => visibility * c.abs().max(LEAST_TEXEL_COSINE),
+                (None, Some(c)) => unseen * c.max(LEAST_TEXEL_COSINE),
+                (visibility, None) => visibility.unwrap_or(unseen),
+            };
+            weight as f64
+        })
+        .collect()
+}
+
+/// `H_t`, the defensive share's weight of each texel of `cell`: 1 wherever light may come
+/// from, [`UNSEEN_TEXEL_SHARE`] behind a surface that only reflects (below the cell's
+/// horizon by more than [`HORIZON_SLACK`], where no ray of the cell went).
+fn defensive_weights(cell: &FieldCell) -> Vec<f64> {
+    let texels = (cell.side() * cell.side()) as usize;
+    let cosine = texel_cosines(cell);
+    (0..texels)
+        .map(|texel| match cosine(texel) {
+            Some(c) if c < -HORIZON_SLACK && cell.pooled_visibility_at(texel).is_none() => {
+                UNSEEN_TEXEL_SHARE as f64
+            }
+            _ => 1.0,
+        })
+        .collect()
 }
 
 /// Whether a cell's visibilities alone make a guide worth it: its darkest texel is below
