@@ -224,7 +224,13 @@ impl Lights {
     /// when it has one.
     #[inline]
     pub fn sample_toward(&self, receiver: &Receiver, u: [f32; 2]) -> Option<Toward> {
-        match self.begin_sample(receiver, u) {
+        self.finish(receiver, self.begin_sample(receiver, u))
+    }
+
+    /// The direction of `draw` for `receiver`, made now if it was left for later.
+    #[inline]
+    pub fn finish(&self, receiver: &Receiver, draw: Draw) -> Option<Toward> {
+        match draw {
             Draw::Made(toward) => toward,
             Draw::Environment(u) => self.environment_toward(receiver, u),
         }

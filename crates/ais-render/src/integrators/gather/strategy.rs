@@ -3,7 +3,7 @@
 
 use crate::bsdf::{HitBsdf, ShadingFrame, SurfacePoint};
 use crate::geometry::Hit;
-use crate::lights::{Draw, EnvironmentDraws, Lights, Receiver, Toward};
+use crate::lights::{Draw, Lights, Receiver, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
@@ -111,16 +111,7 @@ impl GatherPoint<'_> {
     /// The direction of a draw, made now if it was left for later.
     #[inline]
     pub fn finish(&self, draw: Draw) -> Option<Toward> {
-        match draw {
-            Draw::Made(toward) => toward,
-            Draw::Environment(u) => {
-                let mut draws = EnvironmentDraws::default();
-                draws.push(0, u);
-                let mut made = None;
-                draws.draw(self.lights, &self.receiver, |_, toward| made = Some(toward));
-                made
-            }
-        }
+        self.lights.finish(&self.receiver, draw)
     }
 
     /// A direction drawn from the BSDF (`None`: nothing scatters toward the viewer).
