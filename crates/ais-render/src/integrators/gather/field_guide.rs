@@ -291,7 +291,11 @@ fn build(
     if cell.normal().is_none() && !contrast_worth_guiding(partition, cell) {
         return None;
     }
-    let (product, defensive) = (product_weights(cell), defensive_weights(cell));
+    let cosines = texel_cosines(cell);
+    let (product, defensive) = (
+        product_weights(cell, &cosines),
+        defensive_weights(cell, &cosines),
+    );
     // The mixture `(1 − β) p_env H_t + β p_env A_t / Z_A`, renormalised, is itself a
     // product of the environment with per-texel weights: drawn as one. Draws that H_t takes
     // away from behind the surface go to both parts in proportion, and the defensive part
@@ -312,14 +316,12 @@ fn build(
 /// with its neighbours' (texels whose block no ray of the cell went to: a hundredth of the
 /// cell's, [`UNSEEN_TEXEL_SHARE`]), times the cosine to the cell's normal where it knows
 /// one (at least [`LEAST_TEXEL_COSINE`]; behind the surface, its absolute value where rays
-/// went, as through a surface that transmits).
-fn product_weights(cell: &FieldCell) -> Vec<f64> {
-    let texels = (cell.side() * cell.side()) as usize;
+/// went, as through a surface that transmits). `cosines` are [`texel_cosines`]'.
+fn product_weights(cell: &FieldCell, cosines: &[Option<f32>]) -> Vec<f64> {
     let unseen = UNSEEN_TEXEL_SHARE * cell.visibility();
-    let cosine = texel_cosines(cell);
-    (0..texels)
-        .map(|texel| {
-            let weight = match (cell.pooled_visibility_at(texel), cosine(texel)) {
+    (cosines.iter().enumerate())
+        .map(|(texel, &cosine)| {
+            let weight = match (cell.pooled_visibility_at(texel), cosine) {
                 (Some(visibility), Some(c)) => visibility * c.abs().max(LEAST_TEXEL_COSINE),
                 (None, Some(c)) => unseen * c.max(LEAST_TEXEL_COSINE),
                 (visibility, None) => visibility.unwrap_or(unseen),
@@ -331,12 +333,11 @@ fn product_weights(cell: &FieldCell) -> Vec<f64> {
 
 /// `H_t`, the defensive share's weight of each texel of `cell`: 1 wherever light may come
 /// from, [`UNSEEN_TEXEL_SHARE`] behind a surface that only reflects (below the cell's
-/// horizon by more than [`HORIZON_SLACK`], where no ray of the cell went).
-fn defensive_weights(cell: &FieldCell) -> Vec<f64> {
-    let texels = (cell.side() * cell.side()) as usize;
-    let cosine = texel_cosines(cell);
-    (0..texels)
-        .map(|texel| match cosine(texel) {
+/// horizon by more than [`HORIZON_SLACK`], where no ray of the cell went). `cosines` are
+/// [`texel_cosines`]'.
+fn defensive_weights(cell: &FieldCell, cosines: &[Option<f32>]) -> Vec<f64> {
+    (cosines.iter().enumerate())
+        .map(|(texel, &cosine)| match cosine {
             Some(c) if c < -HORIZON_SLACK && cell.pooled_visibility_at(texel).is_none() => {
                 UNSEEN_TEXEL_SHARE as f64
             }
@@ -356,17 +357,19 @@ fn contrast_worth_guiding(partition: &EnvironmentPartition, cell: &FieldCell) ->
     cell.darkest() < GUIDE_CONTRAST * cell.visibility() && free_draws < MOST_FREE_DRAWS
 }
 
-/// The cosine between the cell's mean normal and each texel's centre (`None` where the
-/// cell's normals disagree: [`FieldCell::normal`]).
-fn texel_cosines(cell: &FieldCell) -> impl Fn(usize) -> Option<f32> {
+/// The cosine between the cell's mean normal and each texel's centre, in texel order
+/// (`None` where the cell's normals disagree: [`FieldCell::normal`]).
+fn texel_cosines(cell: &FieldCell) -> Vec<Option<f32>> {
     let side = cell.side();
     let normal = cell.normal().map(Vec3::from);
-    move |texel| {
-        let (row, column) = ((texel as u32 / side) as f32, (texel as u32 % side) as f32);
-        let centre =
-            octahedral::direction_of([(column + 0.5) / side as f32, (row + 0.5) / side as f32]);
-        Some(normal?.dot(Vec3::from(centre).normalize()))
-    }
+    (0..side * side)
+        .map(|texel| {
+            let (row, column) = ((texel / side) as f32, (texel % side) as f32);
+            let centre =
+                octahedral::direction_of([(column + 0.5) / side as f32, (row + 0.5) / side as f32]);
+            Some(normal?.dot(Vec3::from(centre).normalize()))
+        })
+        .collect()
 }
 
 #[cfg(test)]
