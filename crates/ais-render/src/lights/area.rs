@@ -234,8 +234,8 @@ impl AreaLight {
                 })
             }
             AreaShape::Rectangle(rectangle) => {
-                let view = receiver.rectangle_view(rectangle)?;
-                let (direction, pdf, distance) = Rectangle::sample_view(&view, u);
+                let (direction, pdf, distance) = receiver
+                    .with_rectangle_view(rectangle, |view| Rectangle::sample_view(view, u))?;
                 Some(AreaSample {
                     direction,
                     pdf,
@@ -291,9 +291,7 @@ impl AreaLight {
             AreaShape::Sphere { sphere, .. } => {
                 SphereView::new(sphere, receiver.point).map_or(0.0, |cone| cone.density())
             }
-            AreaShape::Rectangle(rectangle) => {
-                1.0 / Rectangle::view_solid_angle(receiver.rectangle_view(rectangle))
-            }
+            AreaShape::Rectangle(rectangle) => 1.0 / receiver.rectangle_solid_angle(rectangle),
             AreaShape::Quadric { quadric, .. } => {
                 let point = receiver.point + direction * distance;
                 let cos = normal.dot(direction).abs() as f64;
@@ -328,7 +326,7 @@ impl AreaLight {
             }
             AreaShape::Rectangle(rectangle) => {
                 if rectangle.intersect(&Ray::new(point, direction)).is_some() {
-                    1.0 / Rectangle::view_solid_angle(receiver.rectangle_view(rectangle))
+                    1.0 / receiver.rectangle_solid_angle(rectangle)
                 } else {
                     0.0
                 }
@@ -375,8 +373,8 @@ impl AreaLight {
                 Some([u0, u1].map(|c| (c as f32).clamp(0.0, super::ONE_BELOW)))
             }
             AreaShape::Rectangle(rectangle) => {
-                let view = receiver.rectangle_view(rectangle)?;
-                Some(Rectangle::square_of(&view, target - receiver.point))
+                let offset = target - receiver.point;
+                receiver.with_rectangle_view(rectangle, |view| Rectangle::square_of(view, offset))
             }
             _ => None,
         }

@@ -3,19 +3,20 @@
 //! Every candidate of a gather starts at the same point. A rectangle light's spherical
 //! rectangle as seen from that point (four acos in f64, and the solid angle) is needed to
 //! sample it and for its density; a [`Receiver`] computes it once per light and keeps it for
-//! the gather's other candidates, in a few direct-mapped slots (no allocation).
+//! the gather's other candidates, in a few direct-mapped slots (no allocation). A view is
+//! over a hundred bytes, so candidates read it in place rather than copy it.
 
 use super::spherical_rectangle::{Rectangle, View};
 use super::{EnvironmentGuide, RegionChoice};
 use ais::sampling::AliasTable;
 use glam::Vec3;
-use std::cell::Cell;
+use std::cell::RefCell;
 
 /// How many rectangle lights' views a receiver keeps at once.
 const VIEW_SLOTS: usize = 4;
 
 /// A slot: the rectangle's address (its key within one scene's lights) and its view.
-type ViewSlot = Cell<Option<(usize, Option<View>)>>;
+type ViewSlot = RefCell<Option<(usize, Option<View>)>>;
 
 /// A point where light is gathered.
 pub struct Receiver<'a> {
@@ -59,19 +60,32 @@ impl<'a> Receiver<'a> {
         self.region_choices.get(light)?.as_ref()
     }
 
-    /// How `rectangle` looks from the point (None: seen edge-on), computed on first use.
+    /// `read` of how `rectangle` looks from the point (None: seen edge-on, and `read` is not
+    /// called), the view computed on first use.
     #[inline]
-    pub(super) fn rectangle_view(&self, rectangle: &Rectangle) -> Option<View> {
+    pub(super) fn with_rectangle_view<R>(
+        &self,
+        rectangle: &Rectangle,
+        read: impl FnOnce(&View) -> R,
+    ) -> Option<R> {
         let key = rectangle as *const Rectangle as usize;
         let slot = &self.views[(key / std::mem::align_of::<Rectangle>()) % VIEW_SLOTS];
-        if let Some((held, view)) = slot.get() {
-            if held == key {
-                return view;
+        if let Some((held, view)) = slot.borrow().as_ref() {
+            if *held == key {
+                return view.as_ref().map(read);
             }
         }
         let view = rectangle.view(self.point);
-        slot.set(Some((key, view)));
-        view
+        let result = view.as_ref().map(read);
+        *slot.borrow_mut() = Some((key, view));
+        result
+    }
+
+    /// The solid angle `rectangle` subtends at the point (0 where it is seen edge-on).
+    #[inline]
+    pub(super) fn rectangle_solid_angle(&self, rectangle: &Rectangle) -> f64 {
+        self.with_rectangle_view(rectangle, View::solid_angle)
+            .unwrap_or(0.0)
     }
 }
 
@@ -93,7 +107,7 @@ mod tests {
         let receiver = Receiver::new(point);
         for round in 0..3 {
             for (i, rectangle) in rectangles.iter().enumerate().rev().skip(round) {
-                let held = Rectangle::view_solid_angle(receiver.rectangle_view(rectangle));
+                let held = receiver.rectangle_solid_angle(rectangle);
                 assert_eq!(held, rectangle.solid_angle(point), "rectangle {i}");
             }
         }

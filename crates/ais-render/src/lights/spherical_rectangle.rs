@@ -39,6 +39,14 @@ pub(crate) struct View {
     draws: Draws,
 }
 
+impl View {
+    /// The solid angle subtended.
+    #[inline]
+    pub(crate) fn solid_angle(&self) -> f64 {
+        self.solid_angle
+    }
+}
+
 /// The precision a view's draws are made in.
 #[derive(Clone, Copy, Debug)]
 enum Draws {
@@ -328,12 +336,7 @@ impl Rectangle {
 
     /// The solid angle the rectangle subtends at `point` (0 in its plane).
     pub fn solid_angle(&self, point: Vec3) -> f64 {
-        Self::view_solid_angle(self.view(point))
-    }
-
-    /// The solid angle it subtends where `view` was seen from (0 for no view).
-    pub(crate) fn view_solid_angle(view: Option<View>) -> f64 {
-        view.map_or(0.0, |v| v.solid_angle)
+        self.view(point).as_ref().map_or(0.0, View::solid_angle)
     }
 
     /// Distance along the ray to the rectangle, if it hits it (either side).
