@@ -220,7 +220,10 @@ fn draw_ahead(
             let (decision, _) = decide(run, batch, &mut values, toward, in_support);
             if let Decision::Trace { weight } = decision {
                 weights[kept] = weight;
-                drawn.swap(kept, k);
+                // (A candidate is over a hundred bytes: most stay where they were drawn.)
+                if kept != k {
+                    drawn.swap(kept, k);
+                }
                 kept += 1;
             }
         }
