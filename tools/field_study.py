@@ -11,7 +11,7 @@ reference's included, which is then cached apart (`FLAGS=--hide-emitters=true`: 
 the camera sees directly is black in every image).
 
 For each scene of scenes/ (names without .xml; `default` is the built-in scene), a reference is rendered once by ais with AIS
-off and 16 rays, as REFERENCE_PARTS (an environment variable, default 4) independent parts of
+off and 16 rays, as REFERENCE_PARTS (an environment variable, default 4, at least 2) independent parts of
 1024 spp each, cached in target/field-study/. The reference is their mean, and the spread of
 the parts gives its own variance per pixel. A relMSE against a noisy reference counts that
 noise too: E[(x − r)²] = E[(x − μ)²] + Var(r). So every relMSE printed has the reference's
@@ -79,7 +79,8 @@ def load_reference(scene, size, variant):
     """The reference of `scene`: the mean of REFERENCE_PARTS independent AIS-off renders
     (rendered once, cached), and the variance of that mean per pixel and channel."""
     parts = []
-    for part in range(int(os.environ.get('REFERENCE_PARTS', '4'))):
+    # At least two parts: their spread is the reference's noise.
+    for part in range(max(2, int(os.environ.get('REFERENCE_PARTS', '4')))):
         path = os.path.join(WORK, f'reference-{scene}-{size}{variant}-part{part}.exr')
         if not os.path.exists(path):
             render(scene, size, 1024, 16, 'off', 777 + part, path)
