@@ -20,7 +20,7 @@ reference's noise (1.7e-4 in the sunlit room from 1024 spp, against 4e-4 measure
 `auto` at 128 candidates and 32 spp) pulls every ratio toward 1. Then every configuration renders
 SEEDS times (default 8) at `--spp` 32 for n = 16 and 8 for n = 128 (SPP sets another), in one process, and the
 script prints per configuration the mean relMSE against the reference (relMSE = mean((x − r)²
-/ (r² + 0.01))) with its standard error over seeds, the median render time (configurations
+/ (r² + 0.01)), the reference's own part subtracted) with its standard error over seeds, the median render time (configurations
 run interleaved, seed by seed), and the
 efficiency ratio against the first configuration: (relMSE · time) of the first over that of
 the row. Its noise (±, one standard error) has two parts, also printed apart: the relMSE
