@@ -5,6 +5,7 @@ use crate::{load_world, parse_resolution, start_threads, SceneFlags, SceneReques
 use ais_render::atomic_write::OutputSet;
 use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
 use ais_render::integrators::gather::field::LEAST_ROLLING_RAYS;
+use ais_render::integrators::gather::race::RaceResult;
 use ais_render::integrators::gather::{GatherStats, MapSource};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
 use ais_render::render::{render, PixelRect, RenderOutput, RenderSettings};
@@ -366,7 +367,16 @@ fn print_gather_summary(
         "AIS memory   {:.1} KiB per thread (maps, shared maps, guides)",
         rendered.output.stats.memory_per_thread as f64 / 1024.0
     );
-    let [rolled, aside] = rendered.output.stats.field_gathers;
+    print_field_summary(settings, &rendered.output.stats);
+}
+
+/// What the learned field did: its size and use, the MIS share it learned, its race against
+/// AIS off and the gather sizes it chose.
+fn print_field_summary(
+    settings: &ais_render::integrators::gather::GatherSettings,
+    stats: &GatherStats,
+) {
+    let [rolled, aside] = stats.field_gathers;
     if settings.map == MapSource::Field && rolled + aside == 0 {
         println!(
             "field        not used: nothing to guide (no environment, and one light without regions), and roulette needs {LEAST_ROLLING_RAYS} rays per gather (rendered as AIS off)"
@@ -375,47 +385,50 @@ fn print_gather_summary(
     if rolled + aside > 0 {
         println!(
             "field        {:.1} KiB; roulette in {:.1}% of gathers, stood aside in the rest; light sampling guided in {:.1}%; cost ratio {:.2}",
-            rendered.output.stats.field_memory as f64 / 1024.0,
+            stats.field_memory as f64 / 1024.0,
             100.0 * rolled as f64 / (rolled + aside) as f64,
-            100.0 * rendered.output.stats.field_guided as f64 / (rolled + aside) as f64,
-            rendered.output.stats.field_cost_ratio
+            100.0 * stats.field_guided as f64 / (rolled + aside) as f64,
+            stats.field_cost_ratio
         );
     }
-    if let Some(share) = rendered.output.stats.mis_share {
+    if let Some(share) = stats.mis_share {
         println!(
             "MIS          BSDF share {share} (learned from the first passes; AIS off uses 0.5)"
         );
     }
-    let stood_aside = rendered.output.stats.field_stood_aside;
-    if settings.map == MapSource::Field && stood_aside && rendered.output.stats.field_race.is_none()
-    {
+    if settings.map == MapSource::Field && stats.field_stood_aside && stats.field_race.is_none() {
         println!("field        stood aside after its first passes: it found almost nothing to guide or roll, and the rest gathered as AIS off");
     }
-    if let Some(race) = rendered.output.stats.field_race {
-        let timed = race
-            .seconds_per_sample
-            .map_or(String::new(), |[field, off]| {
-                format!(
-                    "; time per sample with the field / AIS off {:.3}",
-                    field / off
-                )
-            });
-        println!(
-            "field race   pixel variance with the field {:.3e}, AIS off {:.3e} (ratio {:.3}{timed}): {}",
-            race.field,
-            race.off,
-            race.field / race.off,
-            if race.field_pays() {
-                "the field guides the rest"
-            } else {
-                "the rest gathers as AIS off"
-            }
-        );
+    if let Some(race) = stats.field_race {
+        print_race(&race);
     }
-    if let Some(mean) = rendered.output.stats.gather_sizes {
+    if let Some(mean) = stats.gather_sizes {
         println!(
             "gather sizes {mean:.1} candidates per gather on average over the image's blocks after the race (fewer where the camera's noise dominates; {} asked)",
             settings.rays
         );
     }
+}
+
+/// The field's race against AIS off: each arm's pixel variance, their times, the verdict.
+fn print_race(race: &RaceResult) {
+    let timed = race
+        .seconds_per_sample
+        .map_or(String::new(), |[field, off]| {
+            format!(
+                "; time per sample with the field / AIS off {:.3}",
+                field / off
+            )
+        });
+    println!(
+        "field race   pixel variance with the field {:.3e}, AIS off {:.3e} (ratio {:.3}{timed}): {}",
+        race.field,
+        race.off,
+        race.field / race.off,
+        if race.field_pays() {
+            "the field guides the rest"
+        } else {
+            "the rest gathers as AIS off"
+        }
+    );
 }

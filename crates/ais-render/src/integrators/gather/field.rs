@@ -3,6 +3,7 @@
 //! pass gives back: its rays, and what a candidate and a traced ray cost in this render.
 
 use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse, Lessons};
+use super::field_guide::CellGuide;
 use super::gather_sizes::GatherSizes;
 use super::guiding::CandidateSampler;
 use super::mis_share::ShareMoments;
@@ -13,8 +14,10 @@ use crate::geometry::Hit;
 use crate::render::{Learning, PassEnd, RayCounts};
 use crate::texture::luminance;
 use crate::world::World;
-use ais::field::{CellIndex, CellKey, FieldCell, FieldObservations, VisibilityField, MOST_SOURCES};
-use ais::MapStart;
+use ais::field::{
+    CellIndex, CellKey, CellRecorder, FieldCell, FieldObservations, VisibilityField, MOST_SOURCES,
+};
+use ais::{MapStart, Stats};
 use glam::Vec3;
 use std::cell::Cell;
 use std::sync::Arc;
@@ -141,6 +144,17 @@ pub struct CostSample {
 }
 
 impl CostSample {
+    /// A timed gather started at `started`, its batch's counts `before` and `after` it, and
+    /// `traced`, its time on accepted candidates.
+    fn since(started: Instant, before: &Stats, after: &Stats, traced: Duration) -> Self {
+        CostSample {
+            gathers: started.elapsed(),
+            traced,
+            candidates: after.candidates - before.candidates,
+            accepted: after.traced - before.traced,
+        }
+    }
+
     fn add(&mut self, other: CostSample) {
         self.gathers += other.gathers;
         self.traced += other.traced;
@@ -504,8 +518,7 @@ pub(super) fn field_gather<P: BatchProbe>(
     *raced_off += u64::from(racing_off);
     let cost_ratio = *cost_ratio;
     let known = find_cell(field, last_cell, site.key);
-    let record = known.is_none_or(|(_, cell)| cell.total().traced < WELL_KNOWN)
-        || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN);
+    let record = records(known.map(|(_, cell)| cell), *gathers);
     let rolls = field_rolls(settings);
     let rolling = known
         .map(|(_, cell)| cell)
@@ -513,11 +526,7 @@ pub(super) fn field_gather<P: BatchProbe>(
     let mut at: GatherPoint<'_> = site.at;
     let guides = field_guides.as_mut().filter(|_| !racing_off);
     if let (Some(guides), Some((index, cell))) = (guides, known) {
-        let guide = guides.guide(index, &cell);
-        at.receiver.environment_guide = guide.environment.as_ref();
-        at.receiver.light_choice = guide.lights.as_ref();
-        at.receiver.region_choices = &guide.regions;
-        *field_guided += u64::from(guide.guides());
+        *field_guided += u64::from(follow_guide(&mut at, guides.guide(index, &cell)));
     }
     field_gathers[usize::from(rolling.is_none())] += 1;
     *gathers += 1;
@@ -540,10 +549,7 @@ pub(super) fn field_gather<P: BatchProbe>(
     let mut recorder = observations
         .as_mut()
         .filter(|_| record)
-        .map(|observations| observations.cell_mut(site.key));
-    if let Some(recorder) = recorder.as_mut() {
-        recorder.record_normal(at.frame.normal.into());
-    }
+        .map(|observations| cell_recorder(observations, site.key, &at));
     let lessons = Lessons {
         cell: recorder.as_mut(),
         shares: shares.as_mut(),
@@ -555,13 +561,41 @@ pub(super) fn field_gather<P: BatchProbe>(
     }
     note_gather_variance(race, spread);
     if let Some(started) = site.started {
-        let after = batch.stats();
-        cost.add(CostSample {
-            gathers: started.elapsed(),
-            traced: clock.get(),
-            candidates: after.candidates - before.candidates,
-            accepted: after.traced - before.traced,
-        });
+        cost.add(CostSample::since(
+            started,
+            &before,
+            batch.stats(),
+            clock.get(),
+        ));
     }
     value
+}
+
+/// Whether a gather in `cell` (`None`: a cell the field does not hold) records its rays,
+/// the tile's `gathers`-th: always where the cell is little known, else one gather in
+/// [`WELL_KNOWN_RECORD_ONE_IN`].
+fn records(cell: Option<FieldCell>, gathers: u64) -> bool {
+    cell.is_none_or(|cell| cell.total().traced < WELL_KNOWN)
+        || gathers.is_multiple_of(WELL_KNOWN_RECORD_ONE_IN)
+}
+
+/// Points `at`'s light sampling at its cell's guide; returns whether the guide changes
+/// anything there.
+fn follow_guide<'g>(at: &mut GatherPoint<'g>, guide: &'g CellGuide) -> bool {
+    at.receiver.environment_guide = guide.environment.as_ref();
+    at.receiver.light_choice = guide.lights.as_ref();
+    at.receiver.region_choices = &guide.regions;
+    guide.guides()
+}
+
+/// The recorder of the pass's observations in cell `key`, told the normal of the gather at
+/// `at`.
+fn cell_recorder<'o>(
+    observations: &'o mut FieldObservations,
+    key: CellKey,
+    at: &GatherPoint,
+) -> CellRecorder<'o> {
+    let mut recorder = observations.cell_mut(key);
+    recorder.record_normal(at.frame.normal.into());
+    recorder
 }
