@@ -171,6 +171,47 @@ fn interior(width: u32, height: u32) -> World {
 }
 
 #[test]
+fn a_progressive_study_stops_observing_once_the_field_has_learned() {
+    // Passes of 1 spp that go on from one another, as `ais compare` renders: the field
+    // learns from the first samples, as many as a render of its own learns from, and the
+    // passes after them record nothing.
+    use ais_render::integrators::gather::field::LEARNING_SAMPLES;
+    use ais_render::render::render_learning;
+    let world = interior(24, 16);
+    // Kept throughout (no race to lose): a field that stands aside stops learning anyway.
+    let auto = GatherSettings {
+        rays: 16,
+        field_race: false,
+        ..GatherSettings::preset(Preset::Auto)
+    };
+    let integrator = Integrator::Gather(auto);
+    let mut learned = gather::GatherLearning::new(&world, &auto);
+    let mut traced = Vec::new();
+    for first_sample in 0..LEARNING_SAMPLES + 3 {
+        let settings = RenderSettings {
+            samples_per_pixel: 1,
+            seed: 5,
+            first_sample,
+            progress: false,
+            crop: None,
+        };
+        render_learning(&world, &integrator, &settings, &mut learned);
+        traced.push(learned.field.traced());
+    }
+    let learning = LEARNING_SAMPLES as usize;
+    assert!(
+        traced[..learning].windows(2).all(|pair| pair[1] > pair[0]),
+        "every learning pass adds rays: {traced:?}"
+    );
+    assert!(
+        traced[learning - 1..]
+            .iter()
+            .all(|&t| t == traced[learning - 1]),
+        "no pass after them does: {traced:?}"
+    );
+}
+
+#[test]
 fn the_learned_field_is_thread_independent_and_used() {
     // Two passes of 1 spp: the field learned in the first is fixed for the second, and
     // merged from integer counts, so the image cannot depend on the threads. A room lit

@@ -36,6 +36,14 @@ pub trait Learning: Sync {
     fn keeps_learning(&self) -> bool {
         true
     }
+
+    /// Whether a pass that starts after `samples_before` samples per pixel (taken by this
+    /// render and the renders it goes on from) should still observe, where only later
+    /// renders would read what it learns: a learning that has learned enough says no, and
+    /// such passes do none of the work of observing.
+    fn wants_observations(&self, _samples_before: u32) -> bool {
+        true
+    }
 }
 
 /// Where a render stands when a pass ends.

@@ -184,6 +184,10 @@ fn render_passes<I: SampleIntegrator>(
             samples,
             first_sample: settings.first_sample + passes[..index].iter().sum::<u32>(),
         };
+        // A render's own passes learn for the passes after them; its last pass learns only
+        // for later renders, and only while the learning wants it.
+        let learns = index + 1 < passes.len()
+            || (learning_goes_on && learned.wants_observations(pass.first_sample));
         let results: Vec<_> = rects
             .par_iter()
             .map(|&rect| {
@@ -191,7 +195,7 @@ fn render_passes<I: SampleIntegrator>(
                     rect,
                     image: (width, height),
                     seed: settings.seed,
-                    learns: learning_goes_on || index + 1 < passes.len(),
+                    learns,
                 };
                 let result = render_tile(world, integrator, learned, pass, &tile);
                 progress.inc(1);

@@ -253,6 +253,11 @@ impl VisibilityField {
         self.totals.len()
     }
 
+    /// Rays learned from, over all cells.
+    pub fn traced(&self) -> u64 {
+        self.totals.iter().map(|total| total.traced as u64).sum()
+    }
+
     /// Bytes held by the field.
     pub fn memory_bytes(&self) -> usize {
         std::mem::size_of::<Self>()

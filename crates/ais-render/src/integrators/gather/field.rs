@@ -29,6 +29,15 @@ pub const TIMED_ONE_IN: u64 = 16;
 /// The cost ratio used before anything was measured (and when nothing could be).
 pub const UNMEASURED_COST_RATIO: f32 = 1.0;
 
+/// Samples per pixel of the passes in which a render with `map = field` learns
+/// ([`field_passes`]).
+pub const LEARNING_PASSES: [u32; 4] = [1, 1, 2, 4];
+
+/// Samples per pixel a field learns from: those of its [`LEARNING_PASSES`]. Renders that go
+/// on from earlier ones (a study's progressive passes) stop observing after as many.
+pub const LEARNING_SAMPLES: u32 =
+    LEARNING_PASSES[0] + LEARNING_PASSES[1] + LEARNING_PASSES[2] + LEARNING_PASSES[3];
+
 /// Samples per pixel of the passes of a render with `map = field`: 1, 1, 2, 4, then the
 /// rest, so the field learns early and is used for most samples. (Each pass ends with a
 /// barrier where a core may wait for the last tile: more passes cost more. Learning from 8
@@ -36,7 +45,7 @@ pub const UNMEASURED_COST_RATIO: f32 = 1.0;
 pub fn field_passes(spp: u32) -> Vec<u32> {
     let mut passes = Vec::new();
     let mut done = 0u32;
-    for samples in [1, 1, 2, 4, u32::MAX] {
+    for samples in LEARNING_PASSES.into_iter().chain([u32::MAX]) {
         let samples = samples.min(spp - done);
         if samples == 0 {
             break;
@@ -392,6 +401,13 @@ impl Learning for GatherLearning {
             self.race = Race::default(); // its image-sized sums are no longer needed
         }
         self.passes += 1;
+    }
+
+    /// As a render of its own does, the field learns from its first [`LEARNING_SAMPLES`]
+    /// samples per pixel: observing every later pass of a progressive study cost it time
+    /// (recording its rays, rebuilding its field) that a render of its own does not spend.
+    fn wants_observations(&self, samples_before: u32) -> bool {
+        samples_before < LEARNING_SAMPLES
     }
 
     /// Learning goes on unless the field stands aside ([`GatherLearning::stands_aside`]:
