@@ -3,12 +3,14 @@
 //! closest-hit and occlusion queries.
 
 mod basis;
+mod cwbvh_traversal;
 #[cfg(feature = "embree")]
 mod embree;
 mod instances;
 mod primitive;
 mod quadric;
 mod ray;
+mod triangle_lanes;
 
 pub use basis::basis;
 use instances::{GroupGeometry, Instance};
@@ -19,8 +21,8 @@ pub use quadric::{Quadric, QuadricKind, QuadricSample, QuadricSurface};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
 
 use crate::mesh::{AttributeSite, MeshAttribute, TriangleMesh};
+use cwbvh_traversal::LanedBvh;
 use glam::{Vec2, Vec3};
-use obvhs::cwbvh::CwBvh;
 use std::time::{Duration, Instant};
 
 /// What one shape contributes, in world space.
@@ -116,8 +118,8 @@ pub struct Geometry {
 
 /// What answers ray queries.
 enum Accelerator {
-    /// obvhs's compressed wide BVH (the default).
-    Cwbvh(CwBvh),
+    /// obvhs's compressed wide BVH (the default), its triangles in lanes.
+    Cwbvh(LanedBvh),
     /// Intel Embree 3.
     #[cfg(feature = "embree")]
     Embree(embree::EmbreeScene),
@@ -324,7 +326,7 @@ impl Geometry {
             &mut Duration::default(),
         );
         self.pack_in_order(&primitives, &bvh.primitive_indices);
-        self.accelerator = Some(Accelerator::Cwbvh(bvh));
+        self.accelerator = Some(Accelerator::Cwbvh(LanedBvh::new(bvh, &self.packed)));
     }
 
     /// Packs the primitives with the triangles first, as Embree's scene numbers them, and
@@ -447,7 +449,9 @@ impl Geometry {
     /// The closest hit along the ray, if any.
     pub fn intersect(&self, ray: &Ray) -> Option<Hit> {
         let closest = match self.accelerator.as_ref()? {
-            Accelerator::Cwbvh(bvh) => self.cwbvh_closest(bvh, ray)?,
+            Accelerator::Cwbvh(bvh) => bvh.nearest(ray, |index, t_max| {
+                self.intersect_primitive(index, ray, t_max)
+            })?,
             #[cfg(feature = "embree")]
             Accelerator::Embree(scene) => {
                 let (index, t, barycentrics) = scene.intersect(ray)?;
@@ -473,23 +477,6 @@ impl Geometry {
         }
     }
 
-    /// The CWBVH's closest primitive along the ray.
-    fn cwbvh_closest(&self, bvh: &CwBvh, ray: &Ray) -> Option<Closest> {
-        let mut best: Option<Closest> = None;
-        let mut hit = obvhs::ray::RayHit::none();
-        bvh.ray_traverse(ray.to_bvh(ray.t_max), &mut hit, |r, id| {
-            match self.intersect_primitive(id, ray, r.tmax) {
-                Some(closest) => {
-                    let t = closest.t();
-                    best = Some(closest);
-                    t
-                }
-                None => f32::INFINITY,
-            }
-        });
-        best
-    }
-
     /// The closest hit by testing every primitive: the reference the BVH is tested against.
     pub fn intersect_brute_force(&self, ray: &Ray) -> Option<Hit> {
         let mut best: Option<Closest> = None;
@@ -506,10 +493,9 @@ impl Geometry {
     pub fn occluded(&self, ray: &Ray) -> bool {
         match &self.accelerator {
             None => false,
-            Some(Accelerator::Cwbvh(bvh)) => !bvh
-                .ray_traverse_miss(ray.to_bvh(ray.t_max), |r, id| {
-                    self.blocking_distance(id, ray, r.tmax)
-                }),
+            Some(Accelerator::Cwbvh(bvh)) => bvh.occluded(ray, |index, t_max| {
+                self.blocking_distance(index, ray, t_max) < t_max
+            }),
             #[cfg(feature = "embree")]
             Some(Accelerator::Embree(scene)) => scene.occluded(ray),
         }

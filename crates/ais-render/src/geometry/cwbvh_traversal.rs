@@ -1,0 +1,242 @@
+//! obvhs's compressed wide BVH with its triangles in lanes: traversal visits the nodes as
+//! obvhs does, and tests the primitives a node hands over all together, the triangles eight
+//! at a time ([`TriangleLanes`]) and the rest one by one through the caller.
+
+use super::primitive::Packed;
+use super::ray::Ray;
+use super::triangle_lanes::TriangleLanes;
+use super::Closest;
+use glam::{UVec2, Vec3A};
+use obvhs::cwbvh::{node::CwBvhNode, CwBvh, Traversal};
+
+/// A CWBVH and its primitives' triangles in lanes.
+pub(super) struct LanedBvh {
+    bvh: CwBvh,
+    lanes: TriangleLanes,
+}
+
+impl LanedBvh {
+    /// `bvh` over `packed`, the primitives in the BVH's order.
+    pub(super) fn new(bvh: CwBvh, packed: &[Packed]) -> Self {
+        LanedBvh {
+            lanes: TriangleLanes::new(packed),
+            bvh,
+        }
+    }
+
+    /// Whether anything blocks `ray` before its end. `blocks(index, t_max)` answers for the
+    /// primitives that are not triangles.
+    pub(super) fn occluded(&self, ray: &Ray, mut blocks: impl FnMut(usize, f32) -> bool) -> bool {
+        let bvh_ray = ray.to_bvh(ray.t_max);
+        let mut state = self.bvh.new_traversal(bvh_ray.direction);
+        let mut node;
+        let mut blocked = false;
+        'traversal: {
+            obvhs::traverse!(
+                self.bvh,
+                node,
+                state,
+                children_hit(node, &bvh_ray, state.oct_inv4),
+                {
+                    let (base, group) = take_group(&mut state);
+                    if self.lanes.any_hit(base, group, ray, ray.t_max)
+                        || indices(base, self.lanes.others(base, group))
+                            .any(|index| blocks(index, ray.t_max))
+                    {
+                        blocked = true;
+                        break 'traversal;
+                    }
+                }
+            );
+        }
+        blocked
+    }
+
+    /// The nearest primitive along `ray` before its end. `hit(index, t_max)` answers for the
+    /// primitives that are not triangles.
+    pub(super) fn nearest(
+        &self,
+        ray: &Ray,
+        mut hit: impl FnMut(usize, f32) -> Option<Closest>,
+    ) -> Option<Closest> {
+        let mut bvh_ray = ray.to_bvh(ray.t_max);
+        let mut state = self.bvh.new_traversal(bvh_ray.direction);
+        let mut node;
+        let mut nearest = None;
+        obvhs::traverse!(
+            self.bvh,
+            node,
+            state,
+            children_hit(node, &bvh_ray, state.oct_inv4),
+            {
+                let (base, group) = take_group(&mut state);
+                if let Some(lane_hit) = self.lanes.nearest(base, group, ray, bvh_ray.tmax) {
+                    bvh_ray.tmax = lane_hit.t;
+                    nearest = Some(Closest::Primitive {
+                        index: lane_hit.index,
+                        t: lane_hit.t,
+                        barycentrics: lane_hit.barycentrics,
+                    });
+                }
+                for index in indices(base, self.lanes.others(base, group)) {
+                    if let Some(closest) = hit(index, bvh_ray.tmax) {
+                        bvh_ray.tmax = closest.t();
+                        nearest = Some(closest);
+                    }
+                }
+            }
+        );
+        nearest
+    }
+}
+
+/// The primitives of the node the traversal is at, all taken at once: the first index and
+/// a mask of those to test (bit k: primitive `base + k`).
+#[inline(always)]
+fn take_group(state: &mut Traversal) -> (u32, u32) {
+    let base = state.primitive_group.x;
+    let group = state.primitive_group.y | 1 << (state.primitive_id - base);
+    state.primitive_group = UVec2::new(base, 0);
+    (base, group)
+}
+
+/// The primitive indices that `mask`'s bits stand for, from the highest down.
+fn indices(base: u32, mut mask: u32) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let k = 31 - mask.leading_zeros();
+            mask &= !(1 << k);
+            (base + k) as usize
+        })
+    })
+}
+
+/// Which of `node`'s eight children `ray` enters, as obvhs's traversal wants it: the bits of
+/// the hit children (their primitives' bits in the low 24, an inner child's in the high 8).
+///
+/// obvhs's own test (`CwBvhNode::intersect_ray`) does the same arithmetic four children at a
+/// time with SSE; here the eight children's boxes are tested in one pass that the compiler
+/// vectorises (AVX), each comparison as the SSE instruction makes it (`max(a, b)` is
+/// `a > b ? a : b`), so the same children are entered.
+#[inline(always)]
+fn children_hit(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
+    let scale = node.compute_extent() * ray.inv_direction;
+    let shift = (Vec3A::from(node.p) - ray.origin) * ray.inv_direction;
+    // Per axis, the near and far planes: the ray's sign picks which quantised bound is which.
+    let near_far = |min: &[u8; 8], max: &[u8; 8], negative: bool| {
+        if negative {
+            (*max, *min)
+        } else {
+            (*min, *max)
+        }
+    };
+    let (near_x, far_x) = near_far(&node.child_min_x, &node.child_max_x, ray.direction.x < 0.0);
+    let (near_y, far_y) = near_far(&node.child_min_y, &node.child_max_y, ray.direction.y < 0.0);
+    let (near_z, far_z) = near_far(&node.child_min_z, &node.child_max_z, ray.direction.z < 0.0);
+    let mut entered = [false; 8];
+    for child in 0..8 {
+        let plane = |q: u8, axis: usize| q as f32 * scale[axis] + shift[axis];
+        let t_near = sse_max(
+            plane(near_x[child], 0),
+            sse_max(plane(near_y[child], 1), plane(near_z[child], 2)),
+        );
+        let t_far = sse_min(
+            plane(far_x[child], 0),
+            sse_min(plane(far_y[child], 1), plane(far_z[child], 2)),
+        );
+        entered[child] = sse_max(t_near, NODE_EPSILON) <= sse_min(t_far, ray.tmax);
+    }
+    let (child_bits, bit_index) = node.get_child_and_index_bits(oct_inv4);
+    (0..8).fold(0, |mask, child| {
+        let byte = |bits: u64| ((bits >> (child * 8)) & 0xff) as u32;
+        mask | (byte(child_bits) * entered[child] as u32) << byte(bit_index)
+    })
+}
+
+/// The nearest distance obvhs's node test lets a box start at.
+const NODE_EPSILON: f32 = 0.0001;
+
+/// SSE's `maxps`: `b` unless `a > b` (so `b` when either is NaN).
+#[inline(always)]
+fn sse_max(a: f32, b: f32) -> f32 {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// SSE's `minps`: `b` unless `a < b` (so `b` when either is NaN).
+#[inline(always)]
+fn sse_min(a: f32, b: f32) -> f32 {
+    if a < b {
+        a
+    } else {
+        b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::primitive::Triangle;
+    use ais::rng::Pcg32;
+    use glam::Vec3;
+    use std::time::Duration;
+
+    #[test]
+    fn children_hit_enters_the_children_obvhs_enters() {
+        let mut rng = Pcg32::new(8, 21);
+        let mut point =
+            |scale: f32| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * scale;
+        let triangles: Vec<Triangle> = (0..3000u32)
+            .map(|index| {
+                let v0 = point(20.0);
+                Triangle {
+                    vertices: [v0, v0 + point(1.0), v0 + point(1.0)],
+                    mesh: 0,
+                    index,
+                }
+            })
+            .collect();
+        let bvh = obvhs::cwbvh::builder::build_cwbvh(
+            &triangles,
+            obvhs::BvhBuildParams::medium_build(),
+            &mut Duration::default(),
+        );
+        let mut entered = 0;
+        for i in 0..2000 {
+            let mut direction = (point(2.0) - Vec3::ONE).normalize();
+            // Directions along an axis or a plane: infinite inverse components.
+            if i % 4 == 1 {
+                direction.x = 0.0;
+            }
+            if i % 8 == 2 {
+                direction = Vec3::new(0.0, -1.0, 0.0);
+            }
+            let mut ray = Ray::new(point(22.0) - Vec3::ONE, direction.normalize());
+            ray.t_max = if i % 2 == 0 {
+                f32::INFINITY
+            } else {
+                10.0 * rng_free(i)
+            };
+            let bvh_ray = ray.to_bvh(ray.t_max);
+            let state = bvh.new_traversal(bvh_ray.direction);
+            for node in &bvh.nodes {
+                let expected = node.intersect_ray(&bvh_ray, state.oct_inv4);
+                assert_eq!(
+                    children_hit(node, &bvh_ray, state.oct_inv4),
+                    expected,
+                    "ray {i}"
+                );
+                entered += (expected != 0) as usize;
+            }
+        }
+        assert!(entered > 8_000, "the test must enter nodes: {entered}");
+    }
+
+    /// A distance in (0, 1] that varies with `i` (kept apart from the point generator).
+    fn rng_free(i: usize) -> f32 {
+        ((i * 37) % 100 + 1) as f32 / 100.0
+    }
+}
