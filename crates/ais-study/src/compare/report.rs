@@ -34,8 +34,44 @@ pub struct ReportContext<'a> {
 pub fn markdown_tables(results: &StudyResults, context: &ReportContext) -> String {
     let rows = summary(results, context);
     let mut out = equal_time_table(results, context, &rows);
+    let best = (rows.iter())
+        .filter_map(|row| row.equal_time.as_ref().map(|time| time.rel_mse.mean))
+        .fold(f64::INFINITY, f64::min);
+    let floor = results.reference.noise_floor();
+    if let Some(warning) = reference_warning(floor, best, context.reference_spp) {
+        out.push_str(&warning);
+    }
     out.push_str(&equal_rays_table(results, &rows));
     out
+}
+
+/// The share of the best equal-time relMSE that the reference's own noise may reach before
+/// the study warns: it is subtracted from every relMSE, but its noise stays in the ratios.
+const REFERENCE_NOISE_WARNING: f64 = 0.25;
+
+/// A note under the equal-time table when the reference (`reference_spp` samples per pixel,
+/// its own relMSE `floor`) is too noisy for the best run it judges (relMSE `best`), with the
+/// samples per pixel (a power of two) that would bring its part below a tenth of that.
+fn reference_warning(floor: f64, best: f64, reference_spp: u32) -> Option<String> {
+    if !(floor > 0.0 && best.is_finite() && floor > REFERENCE_NOISE_WARNING * best) {
+        return None;
+    }
+    // A reference's relMSE falls as 1 / spp. A run at or below the reference's own noise
+    // (its relMSE less that noise not above 0) says only that the reference needs many more.
+    let factor = if best > 0.0 { floor / (0.1 * best) } else { 16.0 };
+    let wanted = (reference_spp as f64 * factor).ceil().min(u32::MAX as f64) as u32;
+    let suggested = wanted.next_power_of_two();
+    let (share, advice) = if best > 0.0 {
+        let share = format!("{:.0}% of the best run's ({best:.2e})", 100.0 * floor / best);
+        (share, "would bring it below a tenth")
+    } else {
+        ("as large as the best run's".to_string(), "at least, is needed")
+    };
+    Some(format!(
+        "\n**The reference is too noisy for these runs**: its own relMSE ({floor:.2e}) is \
+         {share}. It is subtracted, but its noise stays in the ratios. A reference of \
+         {suggested} samples per pixel (`--reference-spp {suggested}`) {advice}.\n"
+    ))
 }
 
 /// A ratio, or a dash where it means nothing (a black scene, where both are 0).
@@ -425,4 +461,27 @@ pub fn write(
     let path = folder.join("index.html");
     super::write_text(&path, &html(results, context)?)?;
     Ok(path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_reference_as_noisy_as_the_runs_is_named_with_the_samples_it_needs() {
+        // The sunlit room at n = 16: a reference of 128 spp against runs of about its noise.
+        let warning = reference_warning(1.35e-3, 1.5e-3, 128).expect("a warning");
+        assert!(warning.contains("90%"), "{warning}");
+        // 128 × 1.35e-3 / 1.5e-4 = 1152 samples, rounded up to a power of two.
+        assert!(warning.contains("`--reference-spp 2048`"), "{warning}");
+        // A reference at a tenth of the best run's relMSE says nothing.
+        assert_eq!(reference_warning(1.5e-4, 1.5e-3, 1024), None);
+        // Nor where no run has a relMSE to compare with.
+        assert_eq!(reference_warning(1e-3, f64::INFINITY, 128), None);
+        assert_eq!(reference_warning(0.0, 1e-3, 128), None);
+        // Runs at the reference's own noise: many more samples.
+        let warning = reference_warning(1e-3, -1e-5, 128).expect("a warning");
+        assert!(warning.contains("as large as the best run's"), "{warning}");
+        assert!(warning.contains("`--reference-spp 2048`"), "{warning}");
+    }
 }
