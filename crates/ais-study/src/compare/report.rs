@@ -58,14 +58,24 @@ fn reference_warning(floor: f64, best: f64, reference_spp: u32) -> Option<String
     }
     // A reference's relMSE falls as 1 / spp. A run at or below the reference's own noise
     // (its relMSE less that noise not above 0) says only that the reference needs many more.
-    let factor = if best > 0.0 { floor / (0.1 * best) } else { 16.0 };
+    let factor = if best > 0.0 {
+        floor / (0.1 * best)
+    } else {
+        16.0
+    };
     let wanted = (reference_spp as f64 * factor).ceil().min(u32::MAX as f64) as u32;
     let suggested = wanted.next_power_of_two();
     let (share, advice) = if best > 0.0 {
-        let share = format!("{:.0}% of the best run's ({best:.2e})", 100.0 * floor / best);
+        let share = format!(
+            "{:.0}% of the best run's ({best:.2e})",
+            100.0 * floor / best
+        );
         (share, "would bring it below a tenth")
     } else {
-        ("as large as the best run's".to_string(), "at least, is needed")
+        (
+            "as large as the best run's".to_string(),
+            "at least, is needed",
+        )
     };
     Some(format!(
         "\n**The reference is too noisy for these runs**: its own relMSE ({floor:.2e}) is \
