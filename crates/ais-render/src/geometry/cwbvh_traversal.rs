@@ -9,6 +9,23 @@ use super::Closest;
 use glam::{UVec2, Vec3A};
 use obvhs::cwbvh::{node::CwBvhNode, CwBvh, Traversal};
 
+/// obvhs's traversal loop over the nodes of `$laned` (a [`LanedBvh`]) for `$ray` (obvhs's
+/// ray), each node's children tested by [`children_hit`]; `$primitives` runs for each group
+/// of primitives a node hands over, with the traversal's state in `$state`.
+macro_rules! walk {
+    ($laned:expr, $ray:expr, $state:ident, $primitives:block) => {{
+        let mut $state = $laned.bvh.new_traversal($ray.direction);
+        let mut node;
+        obvhs::traverse!(
+            $laned.bvh,
+            node,
+            $state,
+            children_hit(node, &$ray, $state.oct_inv4),
+            $primitives
+        );
+    }};
+}
+
 /// A CWBVH and its primitives' triangles in lanes.
 pub(super) struct LanedBvh {
     bvh: CwBvh,
@@ -28,26 +45,18 @@ impl LanedBvh {
     /// primitives that are not triangles.
     pub(super) fn occluded(&self, ray: &Ray, mut blocks: impl FnMut(usize, f32) -> bool) -> bool {
         let bvh_ray = ray.to_bvh(ray.t_max);
-        let mut state = self.bvh.new_traversal(bvh_ray.direction);
-        let mut node;
         let mut blocked = false;
         'traversal: {
-            obvhs::traverse!(
-                self.bvh,
-                node,
-                state,
-                children_hit(node, &bvh_ray, state.oct_inv4),
+            walk!(self, bvh_ray, state, {
+                let (base, group) = take_group(&mut state);
+                if self.lanes.any_hit(base, group, ray, ray.t_max)
+                    || indices(base, self.lanes.others(base, group))
+                        .any(|index| blocks(index, ray.t_max))
                 {
-                    let (base, group) = take_group(&mut state);
-                    if self.lanes.any_hit(base, group, ray, ray.t_max)
-                        || indices(base, self.lanes.others(base, group))
-                            .any(|index| blocks(index, ray.t_max))
-                    {
-                        blocked = true;
-                        break 'traversal;
-                    }
+                    blocked = true;
+                    break 'traversal;
                 }
-            );
+            });
         }
         blocked
     }
@@ -60,32 +69,24 @@ impl LanedBvh {
         mut hit: impl FnMut(usize, f32) -> Option<Closest>,
     ) -> Option<Closest> {
         let mut bvh_ray = ray.to_bvh(ray.t_max);
-        let mut state = self.bvh.new_traversal(bvh_ray.direction);
-        let mut node;
         let mut nearest = None;
-        obvhs::traverse!(
-            self.bvh,
-            node,
-            state,
-            children_hit(node, &bvh_ray, state.oct_inv4),
-            {
-                let (base, group) = take_group(&mut state);
-                if let Some(lane_hit) = self.lanes.nearest(base, group, ray, bvh_ray.tmax) {
-                    bvh_ray.tmax = lane_hit.t;
-                    nearest = Some(Closest::Primitive {
-                        index: lane_hit.index,
-                        t: lane_hit.t,
-                        barycentrics: lane_hit.barycentrics,
-                    });
-                }
-                for index in indices(base, self.lanes.others(base, group)) {
-                    if let Some(closest) = hit(index, bvh_ray.tmax) {
-                        bvh_ray.tmax = closest.t();
-                        nearest = Some(closest);
-                    }
+        walk!(self, bvh_ray, state, {
+            let (base, group) = take_group(&mut state);
+            if let Some(lane_hit) = self.lanes.nearest(base, group, ray, bvh_ray.tmax) {
+                bvh_ray.tmax = lane_hit.t;
+                nearest = Some(Closest::Primitive {
+                    index: lane_hit.index,
+                    t: lane_hit.t,
+                    barycentrics: lane_hit.barycentrics,
+                });
+            }
+            for index in indices(base, self.lanes.others(base, group)) {
+                if let Some(closest) = hit(index, bvh_ray.tmax) {
+                    bvh_ray.tmax = closest.t();
+                    nearest = Some(closest);
                 }
             }
-        );
+        });
         nearest
     }
 }
