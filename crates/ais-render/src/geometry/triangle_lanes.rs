@@ -57,9 +57,9 @@ pub(crate) struct TriangleLanes {
 impl TriangleLanes {
     /// The lanes of `packed` (the primitives in BVH order).
     pub(crate) fn new(packed: &[Packed]) -> Self {
-        // One run and one word more than needed: a node's group may start in the last run
-        // and reach past it, and `others` reads two words at a time.
-        let mut runs = vec![Run::default(); packed.len() / LANES + 2];
+        // Room for a last, partial run, and a word past the last one: `others` reads two
+        // words at a time.
+        let mut runs = vec![Run::default(); packed.len() / LANES + 1];
         let mut others = vec![0u64; packed.len() / 64 + 2];
         for (i, primitive) in packed.iter().enumerate() {
             let (run, lane) = (&mut runs[i / LANES], i % LANES);

@@ -64,7 +64,7 @@ fn reference_warning(floor: f64, best: f64, reference_spp: u32) -> Option<String
         16.0
     };
     let wanted = (reference_spp as f64 * factor).ceil().min(u32::MAX as f64) as u32;
-    let suggested = wanted.next_power_of_two();
+    let suggested = wanted.checked_next_power_of_two().unwrap_or(u32::MAX);
     let (share, advice) = if best > 0.0 {
         let share = format!(
             "{:.0}% of the best run's ({best:.2e})",
@@ -493,5 +493,11 @@ mod tests {
         let warning = reference_warning(1e-3, -1e-5, 128).expect("a warning");
         assert!(warning.contains("as large as the best run's"), "{warning}");
         assert!(warning.contains("`--reference-spp 2048`"), "{warning}");
+        // Beyond the largest power of two a u32 holds: the largest count, not an overflow.
+        let warning = reference_warning(1.0, 1e-9, u32::MAX).expect("a warning");
+        assert!(
+            warning.contains(&format!("`--reference-spp {}`", u32::MAX)),
+            "{warning}"
+        );
     }
 }
