@@ -9,16 +9,21 @@ Same work in both renderers: the scene's camera at `--size`, `--spp` camera samp
 pixel, and per camera sample `--rays` gather rays. ais runs its gather with MIS and AIS off
 (half BSDF, half light samples on average); Mitsuba runs its `direct` integrator with
 `--rays`/2 emitter and `--rays`/2 BSDF samples. Every render is one process per scene, as
-Mitsuba's llvm variant has deadlocked on a second scene load here.
+Mitsuba's llvm variant has deadlocked on a second scene load here (each variant's
+process loads the scene once and renders it on request).
 
-Reported per scene, medians over `--runs`:
+The renders are made in `--runs` rounds: each round renders the scene once with every
+renderer in turn (ais at 2 and 1 threads, then each Mitsuba variant, which stays loaded
+between rounds), so that the machine's drift between rounds touches them all alike.
+Reported per scene, medians over the rounds:
 - ais's render time at 2 threads (loading excluded: the "render time" line) and at 1 thread,
-  and the scaling between them;
+  and the scaling between them (the median of the rounds' ratios);
 - Mitsuba 3's llvm_ad_rgb and scalar_rgb render times (`mi.render` after one warm-up
   render, so the llvm variant's JIT compilation is excluded; loading excluded);
 - rays per second, counted by ais for ais; for Mitsuba, the same nominal count
   (camera rays plus `--rays` per camera sample) over its time;
-- the ratio Mitsuba llvm time / ais time (above 1: ais is faster);
+- the ratio Mitsuba llvm time / ais time (above 1: ais is faster): the median of the
+  rounds' ratios;
 - with `--ais-embree PATH` (ais built with `--features embree`, Debian's libembree-dev),
   that binary's render time at 2 threads and its ratio to Mitsuba llvm, in the same run.
 
@@ -32,6 +37,7 @@ import glob
 import json
 import os
 import re
+import select
 import statistics
 import subprocess
 import sys
@@ -42,13 +48,14 @@ import crosscheck  # noqa: E402  (the scene rewrite for Mitsuba and the venv set
 
 ROOT = crosscheck.ROOT
 
-# Renders the scene `runs` times after a warm-up render and prints the times as JSON.
+# Loads the scene, renders it once (the llvm variant compiles its kernels), prints "ready",
+# then renders it once more for every line read and prints that render's time.
 MITSUBA_CHILD = r"""
-import json, sys, time
+import sys, time
 import mitsuba as mi, drjit as dr
 mi.set_variant(sys.argv[2])
 scene = mi.load_file(sys.argv[1])
-spp, runs = int(sys.argv[3]), int(sys.argv[4])
+spp = int(sys.argv[3])
 def timed(seed):
     started = time.perf_counter()
     image = mi.render(scene, seed=seed, spp=spp)
@@ -56,7 +63,9 @@ def timed(seed):
     dr.sync_thread()
     return time.perf_counter() - started
 timed(0)
-print(json.dumps([timed(k + 1) for k in range(runs)]))
+print("ready", flush=True)
+for seed, _ in enumerate(sys.stdin, start=1):
+    print(timed(seed), flush=True)
 """
 
 
@@ -74,63 +83,124 @@ def find_libllvm():
     return max(versioned)[1] if versioned else None
 
 
-def mitsuba_times(scene, variant, args, libllvm):
-    """Median render time of Mitsuba's `variant` on `scene`, or None with a message."""
-    width, height = (int(v) for v in args.size.lower().split("x"))
-    with open(scene) as f:
-        text = crosscheck.mitsuba_scene_text(f.read(), width, height, args.rays // 2)
-    copy = os.path.join(os.path.dirname(os.path.abspath(scene)), f".bench-{os.getpid()}.xml")
-    with open(copy, "w") as f:
-        f.write(text)
-    env = dict(os.environ)
-    if libllvm:
-        env["DRJIT_LIBLLVM_PATH"] = libllvm
+def seconds_in(line):
+    """The number a line holds, or None."""
     try:
-        done = subprocess.run([sys.executable, "-c", MITSUBA_CHILD, copy, variant, str(args.spp), str(args.runs)],
-                              capture_output=True, text=True, env=env, timeout=args.timeout)
-    except subprocess.TimeoutExpired:
-        return None, f"Mitsuba {variant} did not finish within {args.timeout} s"
-    finally:
-        os.remove(copy)
-    if done.returncode != 0:
-        return None, f"Mitsuba {variant} failed: {done.stderr.strip().splitlines()[-1:]}"
-    return statistics.median(json.loads(done.stdout.strip().splitlines()[-1])), None
+        return float(line)
+    except ValueError:
+        return None
 
 
-def ais_run(scene, threads, args, binary=None):
-    """Median render time and counted rays of `ais render` (`binary`, else --ais) on `scene`
-    at `threads`."""
-    times, rays = [], 0
+class MitsubaRenderer:
+    """A Mitsuba process of one variant with `scene` loaded and warmed up, which renders it
+    on request (so that its renders can be interleaved with ais's), or why it could not
+    start (`note`)."""
+
+    def __init__(self, scene, variant, args, libllvm):
+        self.process, self.note, self.timeout = None, None, args.timeout
+        width, height = (int(v) for v in args.size.lower().split("x"))
+        with open(scene) as f:
+            text = crosscheck.mitsuba_scene_text(f.read(), width, height, args.rays // 2)
+        self.copy = os.path.join(os.path.dirname(os.path.abspath(scene)), f".bench-{os.getpid()}-{variant}.xml")
+        with open(self.copy, "w") as f:
+            f.write(text)
+        env = dict(os.environ)
+        if libllvm:
+            env["DRJIT_LIBLLVM_PATH"] = libllvm
+        self.variant = variant
+        # Its log goes to a file: a pipe nobody reads could fill and stall it.
+        self.log = tempfile.TemporaryFile(mode="w+")
+        self.process = subprocess.Popen([sys.executable, "-c", MITSUBA_CHILD, self.copy, variant, str(args.spp)],
+                                        stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.log,
+                                        text=True, env=env)
+        if self._answer(lambda line: line if line == "ready" else None) is None:
+            self.close()
+
+    def _answer(self, parse):
+        """The first line of the child's that `parse` accepts (other lines are its log), or
+        None (with `note` set) if it failed or did not answer within the timeout."""
+        while True:
+            if not select.select([self.process.stdout], [], [], self.timeout)[0]:
+                self.note = f"Mitsuba {self.variant} did not answer within {self.timeout} s"
+                return None
+            line = self.process.stdout.readline()
+            if not line:
+                self.log.seek(0)
+                self.note = f"Mitsuba {self.variant} failed: {self.log.read().strip().splitlines()[-1:]}"
+                return None
+            answer = parse(line.strip())
+            if answer is not None:
+                return answer
+
+    def render(self):
+        """The time of one render, or None."""
+        if self.note:
+            return None
+        self.process.stdin.write("render\n")
+        self.process.stdin.flush()
+        return self._answer(seconds_in)
+
+    def close(self):
+        if self.process and self.process.poll() is None:
+            self.process.kill()
+            self.process.wait()
+        if os.path.exists(self.copy):
+            os.remove(self.copy)
+        self.log.close()
+
+
+def ais_render(scene, threads, args, seed, binary=None):
+    """Render time and counted rays of one `ais render` (`binary`, else --ais) of `scene` at
+    `threads`."""
     with tempfile.TemporaryDirectory() as work:
-        for k in range(args.runs):
-            command = [binary or args.ais, "render", scene, "--resolution", args.size, "--spp", str(args.spp),
-                       "--integrator", "gather", "--strategy", "mis", "--rays", str(args.rays), "--ais", "off",
-                       "--threads", str(threads), "--seed", str(k), "--no-preview",
-                       "-o", os.path.join(work, "ais.exr")]
-            done = subprocess.run(command, capture_output=True, text=True)
-            if done.returncode != 0:
-                crosscheck.fail_setup(f"`{' '.join(command)}` failed:\n{done.stderr.strip()}")
-            report = done.stdout + done.stderr
-            times.append(float(re.search(r"render time\s+([0-9.]+) s", report).group(1)))
-            counted = re.search(r"rays\s+(\d+) camera \+ (\d+) occlusion", report)
-            rays = int(counted.group(1)) + int(counted.group(2))
-    return statistics.median(times), rays
+        command = [binary or args.ais, "render", scene, "--resolution", args.size, "--spp", str(args.spp),
+                   "--integrator", "gather", "--strategy", "mis", "--rays", str(args.rays), "--ais", "off",
+                   "--threads", str(threads), "--seed", str(seed), "--no-preview",
+                   "-o", os.path.join(work, "ais.exr")]
+        done = subprocess.run(command, capture_output=True, text=True)
+    if done.returncode != 0:
+        crosscheck.fail_setup(f"`{' '.join(command)}` failed:\n{done.stderr.strip()}")
+    report = done.stdout + done.stderr
+    counted = re.search(r"rays\s+(\d+) camera \+ (\d+) occlusion", report)
+    return float(re.search(r"render time\s+([0-9.]+) s", report).group(1)), int(counted.group(1)) + int(counted.group(2))
+
+
+def median_or_none(values):
+    values = [v for v in values if v is not None]
+    return statistics.median(values) if values else None
 
 
 def measure(scene, args, libllvm):
-    """One row of the table."""
+    """One row of the table: `--runs` rounds, each rendering once with every renderer in
+    turn, so that the machine's drift between rounds touches all of them alike; medians of
+    the times, and of each round's ratios."""
     width, height = (int(v) for v in args.size.lower().split("x"))
-    nominal_rays = width * height * args.spp * (1 + args.rays)
-    ais2, rays = ais_run(scene, 2, args)
-    ais1, _ = ais_run(scene, 1, args)
-    row = {"scene": os.path.relpath(scene, ROOT), "ais_2": ais2, "ais_1": ais1, "ais_rays": rays,
-           "scaling": ais1 / ais2, "nominal_rays": nominal_rays,
-           "embree_2": ais_run(scene, 2, args, args.ais_embree)[0] if args.ais_embree else None}
-    for variant in ("llvm_ad_rgb", "scalar_rgb"):
-        if variant == "llvm_ad_rgb" and not libllvm:
-            row[variant], row[variant + "_note"] = None, "no LLVM library (install Debian's libllvm19)"
-            continue
-        row[variant], row[variant + "_note"] = mitsuba_times(scene, variant, args, libllvm)
+    variants = ["llvm_ad_rgb", "scalar_rgb"] if libllvm else ["scalar_rgb"]
+    mitsuba = {variant: MitsubaRenderer(scene, variant, args, libllvm) for variant in variants}
+    rounds = []
+    try:
+        for k in range(args.runs):
+            ais2, rays = ais_render(scene, 2, args, k)
+            one = {"ais_2": ais2, "ais_rays": rays, "ais_1": ais_render(scene, 1, args, k)[0],
+                   "embree_2": ais_render(scene, 2, args, k, args.ais_embree)[0] if args.ais_embree else None}
+            for variant, renderer in mitsuba.items():
+                one[variant] = renderer.render()
+            rounds.append(one)
+    finally:
+        for renderer in mitsuba.values():
+            renderer.close()
+    column = {key: median_or_none([r[key] for r in rounds]) for key in rounds[0]}
+    row = {"scene": os.path.relpath(scene, ROOT), "nominal_rays": width * height * args.spp * (1 + args.rays),
+           **column, "ais_rays": rounds[-1]["ais_rays"],
+           "scaling": median_or_none([r["ais_1"] / r["ais_2"] for r in rounds]),
+           "llvm_ratio": median_or_none([r["llvm_ad_rgb"] / r["ais_2"] for r in rounds
+                                         if r.get("llvm_ad_rgb")]),
+           "embree_ratio": median_or_none([r["llvm_ad_rgb"] / r["embree_2"] for r in rounds
+                                           if r.get("llvm_ad_rgb") and r["embree_2"]])}
+    row["llvm_ad_rgb_note"] = (mitsuba["llvm_ad_rgb"].note if libllvm
+                               else "no LLVM library (install Debian's libllvm19)")
+    row.setdefault("llvm_ad_rgb", None)
+    row["scalar_rgb_note"] = mitsuba["scalar_rgb"].note
     return row
 
 
@@ -150,10 +220,11 @@ def print_rows(rows, markdown):
     for row in rows:
         llvm = row["llvm_ad_rgb"]
         lines.append([row["scene"], seconds(row["ais_2"]), rate(row["ais_rays"], row["ais_2"]), seconds(llvm),
-                      rate(row["nominal_rays"], llvm), f"{llvm / row['ais_2']:.2f}×" if llvm else "—",
+                      rate(row["nominal_rays"], llvm), f"{row['llvm_ratio']:.2f}×" if row["llvm_ratio"] else "—",
                       seconds(row["scalar_rgb"]), seconds(row["ais_1"]), f"{row['scaling']:.2f}×"])
         if embree:
-            lines[-1] += [seconds(row["embree_2"]), f"{llvm / row['embree_2']:.2f}×" if llvm else "—"]
+            lines[-1] += [seconds(row["embree_2"]),
+                          f"{row['embree_ratio']:.2f}×" if row["embree_ratio"] else "—"]
     if markdown:
         print("| " + " | ".join(header) + " |")
         print("|" + "---|" * len(header))
