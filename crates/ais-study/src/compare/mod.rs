@@ -391,20 +391,26 @@ struct Runner<'a> {
 
 impl Runner<'_> {
     /// Every configuration at equal time (but the oracle), then at equal rays with the
-    /// baseline's median ray count, which is returned too.
+    /// baseline's median ray count, which is returned too. The equal-time runs take turns,
+    /// seed by seed (every configuration's first seed, then every configuration's second,
+    /// …): the machine's drift during the study touches every configuration alike.
     fn all(&self) -> (Vec<ConfigurationResult>, u64) {
         let time_budget = Budget::Seconds(self.settings.time_budget.as_secs_f64());
-        let mut results: Vec<ConfigurationResult> = self
-            .settings
-            .configurations
+        let configurations = &self.settings.configurations;
+        let mut equal_time: Vec<Vec<Run>> = configurations.iter().map(|_| Vec::new()).collect();
+        for s in 0..self.settings.seeds {
+            for (configuration, runs) in configurations.iter().zip(&mut equal_time) {
+                if !configuration.is_oracle() {
+                    runs.push(self.run(configuration, time_budget, seed_of(s), s));
+                }
+            }
+        }
+        let mut results: Vec<ConfigurationResult> = configurations
             .iter()
-            .map(|configuration| ConfigurationResult {
+            .zip(equal_time)
+            .map(|(configuration, equal_time)| ConfigurationResult {
                 configuration: configuration.clone(),
-                equal_time: if configuration.is_oracle() {
-                    Vec::new()
-                } else {
-                    self.runs(configuration, time_budget, seed_of)
-                },
+                equal_time,
                 equal_rays: Vec::new(),
             })
             .collect();
@@ -416,39 +422,33 @@ impl Runner<'_> {
         baseline_rays.sort_unstable();
         let ray_budget = baseline_rays[baseline_rays.len() / 2];
         for result in &mut results {
-            result.equal_rays = self.runs(&result.configuration, Budget::Rays(ray_budget), |s| {
-                seed_of(s) ^ 0xe0
-            });
+            result.equal_rays = (0..self.settings.seeds)
+                .map(|s| {
+                    let seed = seed_of(s) ^ 0xe0;
+                    self.run(&result.configuration, Budget::Rays(ray_budget), seed, s)
+                })
+                .collect();
         }
         (results, ray_budget)
     }
 
-    /// Every seed of `configuration` within `budget`, seeded from `seed`.
-    fn runs(
-        &self,
-        configuration: &Configuration,
-        budget: Budget,
-        seed: impl Fn(u32) -> u64,
-    ) -> Vec<Run> {
+    /// Run `s` of `configuration` within `budget`, seeded with `seed`.
+    fn run(&self, configuration: &Configuration, budget: Budget, seed: u64, s: u32) -> Run {
         let what = match budget {
             Budget::Seconds(_) => "equal time",
             Budget::Rays(_) => "equal rays",
         };
-        (0..self.settings.seeds)
-            .map(|s| {
-                self.bar
-                    .set_message(format!("{} ({what}, seed {s})", configuration.name));
-                let run = progressive(
-                    self.world,
-                    configuration,
-                    self.reference,
-                    (seed(s), self.settings.pass_spp),
-                    budget,
-                );
-                self.bar.inc(1);
-                run
-            })
-            .collect()
+        self.bar
+            .set_message(format!("{} ({what}, seed {s})", configuration.name));
+        let run = progressive(
+            self.world,
+            configuration,
+            self.reference,
+            (seed, self.settings.pass_spp),
+            budget,
+        );
+        self.bar.inc(1);
+        run
     }
 }
 
