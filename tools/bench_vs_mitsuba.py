@@ -34,14 +34,14 @@ numpy, as tools/crosscheck.py does.
 """
 import argparse
 import glob
-import json
 import os
 import re
-import select
+import queue
 import statistics
 import subprocess
 import sys
 import tempfile
+import threading
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import crosscheck  # noqa: E402  (the scene rewrite for Mitsuba and the venv set-up)
@@ -113,18 +113,29 @@ class MitsubaRenderer:
         self.process = subprocess.Popen([sys.executable, "-c", MITSUBA_CHILD, self.copy, variant, str(args.spp)],
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.log,
                                         text=True, env=env)
+        # Its answers are read by a thread, so that waiting for one can time out.
+        self.lines = queue.Queue()
+        threading.Thread(target=self._read, daemon=True).start()
         if self._answer(lambda line: line if line == "ready" else None) is None:
             self.close()
+
+    def _read(self):
+        """Queues the child's lines, then None when it ends."""
+        for line in self.process.stdout:
+            self.lines.put(line)
+        self.lines.put(None)
 
     def _answer(self, parse):
         """The first line of the child's that `parse` accepts (other lines are its log), or
         None (with `note` set) if it failed or did not answer within the timeout."""
         while True:
-            if not select.select([self.process.stdout], [], [], self.timeout)[0]:
+            try:
+                line = self.lines.get(timeout=self.timeout)
+            except queue.Empty:
                 self.note = f"Mitsuba {self.variant} did not answer within {self.timeout} s"
                 return None
-            line = self.process.stdout.readline()
-            if not line:
+            if line is None:
+                self.process.wait()
                 self.log.seek(0)
                 self.note = f"Mitsuba {self.variant} failed: {self.log.read().strip().splitlines()[-1:]}"
                 return None
@@ -141,6 +152,7 @@ class MitsubaRenderer:
         return self._answer(seconds_in)
 
     def close(self):
+        """Stops the process and removes its scene file."""
         if self.process and self.process.poll() is None:
             self.process.kill()
             self.process.wait()
