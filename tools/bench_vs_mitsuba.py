@@ -178,8 +178,14 @@ def ais_render(scene, threads, args, seed, binary=None):
 
 
 def median_or_none(values):
+    """The median of the values that are not None, or None."""
     values = [v for v in values if v is not None]
     return statistics.median(values) if values else None
+
+
+def median_ratio(rounds, top, bottom):
+    """The median over `rounds` of `top` / `bottom` where a round has both, or None."""
+    return median_or_none([r[top] / r[bottom] for r in rounds if r.get(top) and r.get(bottom)])
 
 
 def measure(scene, args, libllvm):
@@ -204,11 +210,9 @@ def measure(scene, args, libllvm):
     column = {key: median_or_none([r[key] for r in rounds]) for key in rounds[0]}
     row = {"scene": os.path.relpath(scene, ROOT), "nominal_rays": width * height * args.spp * (1 + args.rays),
            **column, "ais_rays": rounds[-1]["ais_rays"],
-           "scaling": median_or_none([r["ais_1"] / r["ais_2"] for r in rounds]),
-           "llvm_ratio": median_or_none([r["llvm_ad_rgb"] / r["ais_2"] for r in rounds
-                                         if r.get("llvm_ad_rgb")]),
-           "embree_ratio": median_or_none([r["llvm_ad_rgb"] / r["embree_2"] for r in rounds
-                                           if r.get("llvm_ad_rgb") and r["embree_2"]])}
+           "scaling": median_ratio(rounds, "ais_1", "ais_2"),
+           "llvm_ratio": median_ratio(rounds, "llvm_ad_rgb", "ais_2"),
+           "embree_ratio": median_ratio(rounds, "llvm_ad_rgb", "embree_2")}
     row["llvm_ad_rgb_note"] = (mitsuba["llvm_ad_rgb"].note if libllvm
                                else "no LLVM library (install Debian's libllvm19)")
     row.setdefault("llvm_ad_rgb", None)
