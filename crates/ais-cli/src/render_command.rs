@@ -393,7 +393,7 @@ fn print_field_summary(
     }
     if let Some(share) = stats.mis_share {
         println!(
-            "MIS          BSDF share {share} (learned from the first passes; AIS off uses 0.5)"
+            "MIS          BSDF share {share} (auto's: learned from the first passes below 64 candidates, 0.25 from 64 on; AIS off uses 0.5)"
         );
     }
     if settings.map == MapSource::Field && stats.field_stood_aside && stats.field_race.is_none() {

@@ -3,6 +3,7 @@
 
 use ais_render::default_scene::default_world;
 use ais_render::film::ReconstructionFilter;
+use ais_render::integrators::gather::mis_share::ROLLING_MIS_SHARE;
 use ais_render::integrators::gather::{self, GatherStats};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, MapUse, Preset, Sharing};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
@@ -240,6 +241,8 @@ fn the_learned_field_is_thread_independent_and_used() {
         assert!(one.stats.ais.rejected_roulette > 0, "the field rejects");
         assert!(one.stats.field_memory > 0);
         assert_eq!(one.stats.field_guided > 0, map_use == MapUse::Both);
+        // Where the field rolls, MIS gives the BSDF a quarter of the candidates.
+        assert_eq!(one.stats.mis_share, Some(ROLLING_MIS_SHARE), "{map_use:?}");
     }
 }
 

@@ -1,4 +1,6 @@
-//! The BSDF's share of one-sample MIS, learned from the gathers' own candidates.
+//! The BSDF's share of one-sample MIS, learned from the gathers' own candidates where the
+//! field does not roll (below 64 candidates), and fixed where it does
+//! ([`ROLLING_MIS_SHARE`]).
 //!
 //! MIS draws a candidate from the BSDF with probability `c` and from the lights otherwise,
 //! and weighs it by the mixture's density `q_c = c p_B + (1 − c) p_L`. Which `c` is best
@@ -32,6 +34,17 @@ use std::collections::HashMap;
 /// The BSDF shares a render chooses among (the default,
 /// [`MIS_BSDF_WEIGHT`](super::strategy::MIS_BSDF_WEIGHT), among them).
 pub const MIS_SHARES: [f64; 4] = [0.125, 0.25, 0.5, 0.75];
+
+/// MIS's BSDF share where the field rolls (64 candidates or more), where no share is
+/// learned: light sampling, guided by a field taught from the first passes, is the better
+/// of the two strategies there, and the BSDF's draws the defensive part. Pinned at
+/// n = 128 and measured by `ais compare` (equal time, 3 s, a field taught as a render's
+/// is), 0.25 against 0.5 gained 1.51× on the default scene, 1.26× behind a roof edge,
+/// 1.24× in the foliage and 1.11× in the courtyard, tied in four more scenes and lost 3% in
+/// the overcast room and 20% in the sunlit room; 0.75 lost or tied everywhere (the
+/// repository's BENCHMARKS.md, section 5.6). A share learned from the candidates' moments
+/// lost in the rooms there, and one raced in the race passes chose by a field too young.
+pub const ROLLING_MIS_SHARE: f64 = 0.25;
 
 /// A share is chosen only from at least this many gathers with light, else the last share
 /// stays.

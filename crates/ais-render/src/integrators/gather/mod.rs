@@ -74,7 +74,8 @@ pub struct GatherStats {
     pub field_race: Option<RaceResult>,
     /// Whether the field stood aside for the last pass (it gathered as AIS off).
     pub field_stood_aside: bool,
-    /// The BSDF's share of MIS in the last pass, where the field's first passes learned it
+    /// The BSDF's share of MIS in the last pass, where `map = field` chose it: learned by
+    /// its first passes below 64 candidates, [`mis_share::ROLLING_MIS_SHARE`] from 64 on
     /// (`None`: the default, [`strategy::MIS_BSDF_WEIGHT`]).
     pub mis_share: Option<f64>,
     /// The mean candidates per gather over the image's blocks, where the race chose them
@@ -178,9 +179,11 @@ impl<P: BatchProbe> GatherTile<P> {
         let rolls = field::field_rolls(settings);
         // Where the field rolls (64 candidates or more), a share that lowers the variance
         // per candidate also changes what roulette skips and what a candidate costs: there
-        // a learned share lost in the rooms, and MIS keeps its default.
+        // a learned share lost in the rooms, and MIS takes `ROLLING_MIS_SHARE`.
         let has_use = field && field::field_has_use(world, settings);
-        let learns_share = has_use && settings.strategy == Strategy::Mis && !rolls;
+        let mis = has_use && settings.strategy == Strategy::Mis;
+        let learns_share = mis && !rolls;
+        let fixed_share = (mis && rolls).then_some(mis_share::ROLLING_MIS_SHARE);
         let race_pass = tile.learns && race::RACE_PASSES.contains(&learning.passes_ended());
         let races = race_pass && field::races(world, settings);
         // The race passes measure the pixels for the candidates per block, raced or not.
@@ -218,7 +221,10 @@ impl<P: BatchProbe> GatherTile<P> {
             race_result: learning.race_result(),
             probe,
             shares: (learns_share && tile.learns).then(ShareMoments::default),
-            mis_share: learning.mis_share().filter(|_| learns_share),
+            mis_share: learning
+                .mis_share()
+                .filter(|_| learns_share)
+                .or(fixed_share),
             settings_rays: settings.rays,
             sizes: learning.gather_sizes().cloned(),
             rays: settings.rays,
