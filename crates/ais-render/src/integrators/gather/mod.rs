@@ -183,7 +183,10 @@ impl<P: BatchProbe> GatherTile<P> {
         let has_use = field && field::field_has_use(world, settings);
         let mis = has_use && settings.strategy == Strategy::Mis;
         let learns_share = mis && !rolls;
-        let fixed_share = (mis && rolls).then_some(mis_share::ROLLING_MIS_SHARE);
+        // (Only where the field guides light sampling: that is what the share was measured
+        // for.)
+        let guided = field::field_can_guide(world, settings);
+        let fixed_share = (mis && rolls && guided).then_some(mis_share::ROLLING_MIS_SHARE);
         let race_pass = tile.learns && race::RACE_PASSES.contains(&learning.passes_ended());
         let races = race_pass && field::races(world, settings);
         // The race passes measure the pixels for the candidates per block, raced or not.
