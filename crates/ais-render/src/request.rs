@@ -134,6 +134,22 @@ pub fn gather_settings(
         }
     }
     settings.validate()?;
+    let scene_given = integrator
+        .filter(|plugin| plugin.kind == "gather")
+        .into_iter()
+        .flat_map(|plugin| plugin.properties.iter())
+        .map(|(name, property)| {
+            (
+                name.as_str(),
+                format!("{file}:{}: \"{name}\"", property.line),
+            )
+        });
+    let flag_given = overrides.iter().map(|o| (o.name, spell(o.name)));
+    for (name, said) in scene_given.chain(flag_given) {
+        if let Some(why) = settings.inapplicable(name) {
+            warnings.push(format!("{said} is ignored: {why}"));
+        }
+    }
     Ok(settings)
 }
 

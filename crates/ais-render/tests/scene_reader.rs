@@ -383,6 +383,65 @@ fn any_mitsuba_integrator_renders_as_the_gather_with_a_warning() {
 }
 
 #[test]
+fn gather_parameters_that_cannot_apply_are_warned_of() {
+    use ais_render::request::{gather_settings, ParameterOverride};
+    let text = "<scene><integrator type=\"gather\">\n<string name=\"ais\" value=\"off\"/>\n\
+                <integer name=\"field_res\" value=\"8\"/>\n<integer name=\"rays\" value=\"16\"/>\n\
+                </integrator></scene>";
+    let world = ais_render::world::World::from_description(parse(text).unwrap()).unwrap();
+    let warned = |overrides: &[(&'static str, &str)]| {
+        let overrides: Vec<ParameterOverride> = overrides
+            .iter()
+            .map(|&(name, value)| ParameterOverride {
+                name,
+                value: value.to_string(),
+            })
+            .collect();
+        let mut warnings = Vec::new();
+        gather_settings(&world, &overrides, |n| format!("--{n}"), &mut warnings).unwrap();
+        warnings
+    };
+    let scene_only = warned(&[]);
+    assert_eq!(
+        scene_only,
+        ["/scenes/test.xml:3: \"field_res\" is ignored: it applies only to the visibility field \
+          (map field: ais auto)"],
+    );
+    let flags = warned(&[
+        ("field_race", "false"),
+        ("acceptance", "sqrt"),
+        ("sharing", "pass"),
+        ("guide_fraction", "0.5"),
+        ("map_res", "8"),
+        ("placement", "random"),
+    ]);
+    for flag in [
+        "--field_race",
+        "--acceptance",
+        "--sharing",
+        "--guide_fraction",
+        "--map_res",
+    ] {
+        assert!(
+            flags
+                .iter()
+                .any(|w| w.starts_with(&format!("{flag} is ignored"))),
+            "{flag} missing from {flags:?}"
+        );
+    }
+    assert!(!flags.iter().any(|w| w.contains("placement")), "{flags:?}");
+    // Under the field, its own parameters apply; a cost ratio needs roulette's 64 rays.
+    let field = warned(&[
+        ("ais", "auto"),
+        ("field_race", "false"),
+        ("cost_ratio", "1"),
+    ]);
+    assert_eq!(field.len(), 1, "{field:?}");
+    assert!(field[0].starts_with("--cost_ratio is ignored: the field rolls only"));
+    assert!(warned(&[("ais", "auto"), ("rays", "64"), ("cost_ratio", "1")]).is_empty());
+}
+
+#[test]
 fn texture_errors_name_file_line_and_problem() {
     let shape = |bsdf: &str| {
         format!("<scene>{bsdf}<shape type=\"rectangle\"><ref id=\"b\"/></shape></scene>")

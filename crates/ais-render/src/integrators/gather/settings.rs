@@ -630,6 +630,44 @@ impl GatherSettings {
         }
     }
 
+    /// Why parameter `name` changes nothing under these settings, if it does not: each
+    /// parameter belongs to one kind of map (see the module's table), and a parameter given
+    /// for another is worth a warning rather than silence.
+    pub fn inapplicable(&self, name: &str) -> Option<String> {
+        let field = self.map == MapSource::Field;
+        let why = match name {
+            "cost_ratio" | "field_res" | "field_cell" | "field_prior" | "field_race"
+            | "field_sizes"
+                if !field =>
+            {
+                Some("it applies only to the visibility field (map field: ais auto)")
+            }
+            "cost_ratio" if !super::field::field_rolls(self) => {
+                return Some(format!(
+                    "the field rolls only with map_use roulette or both and at least {} rays, \
+                     and only then is a cost ratio used",
+                    super::field::LEAST_ROLLING_RAYS
+                ))
+            }
+            "sharing" if self.map != MapSource::Neighbours => Some(
+                "it applies only to maps blended from neighbours (map neighbours: ais shared, \
+                 warm or guided)",
+            ),
+            "tol" | "map_res" if matches!(self.map, MapSource::None | MapSource::Field) => Some(
+                "it applies only to the per-batch and neighbours' maps (ais aggressive, \
+                 conservative, shared, warm or guided)",
+            ),
+            "guide_fraction" if !self.map_use.guides() => {
+                Some("it applies only where a map guides the proposal (map_use proposal or both)")
+            }
+            "acceptance" if self.map == MapSource::None => {
+                Some("AIS off (map none) rejects no candidate")
+            }
+            _ => None,
+        };
+        why.map(str::to_string)
+    }
+
     /// The guide's share of the proposal: as given, else [`super::guiding::GUIDE_FRACTION`]
     /// for a neighbours' map and [`super::field_guide::FIELD_GUIDE_FRACTION`] for the field.
     pub fn guide_share(&self) -> f32 {
