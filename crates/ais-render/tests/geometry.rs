@@ -1,7 +1,9 @@
 //! Intersections against analytic answers, the BVH against brute force, and ray offsets.
 
 use ais::rng::Pcg32;
-use ais_render::geometry::{spawn_ray, Geometry, Ray, ShapeGeometry, ShapeInput, Sphere, Triangle};
+use ais_render::geometry::{
+    spawn_ray, Geometry, LastBlocker, Ray, ShapeGeometry, ShapeInput, Sphere, Triangle,
+};
 use ais_render::mesh::TriangleMesh;
 use ais_render::shapes;
 use glam::{DMat4, DVec3, Vec3};
@@ -167,6 +169,35 @@ fn bvh_agrees_with_brute_force_on_random_rays() {
         );
     }
     assert!(hits > 1000, "the test must exercise hits: {hits}");
+}
+
+#[test]
+fn rays_from_one_origin_are_answered_alike_after_a_blocker() {
+    let mut rng = Pcg32::new(17, 3);
+    let geometry = random_scene(&mut rng);
+    let mut blocked = 0;
+    for origin in 0..400 {
+        let origin_point = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0;
+        // One gather's rays: one origin, one remembered blocker.
+        let mut last = LastBlocker::default();
+        for i in 0..16 {
+            let mut ray = Ray::new(origin_point, random_unit(&mut rng));
+            if i % 3 == 0 {
+                ray.t_max = 3.0 * rng.next_f32();
+            }
+            let expected = geometry.intersect_brute_force(&ray).is_some();
+            assert_eq!(
+                geometry.occluded_after(&ray, &mut last),
+                expected,
+                "origin {origin}, ray {i}"
+            );
+            blocked += expected as usize;
+        }
+    }
+    assert!(
+        blocked > 2000,
+        "the test must exercise blocked rays: {blocked}"
+    );
 }
 
 /// A random point on the sphere or on the acne test's triangle.

@@ -41,24 +41,44 @@ impl LanedBvh {
         }
     }
 
-    /// Whether anything blocks `ray` before its end. `blocks(index, t_max)` answers for the
-    /// primitives that are not triangles.
-    pub(super) fn occluded(&self, ray: &Ray, mut blocks: impl FnMut(usize, f32) -> bool) -> bool {
+    /// The primitive that blocks `ray` before its end, if any (the first found, not the
+    /// nearest). `blocks(index, t_max)` answers for the primitives that are not triangles.
+    pub(super) fn blocker(
+        &self,
+        ray: &Ray,
+        mut blocks: impl FnMut(usize, f32) -> bool,
+    ) -> Option<usize> {
         let bvh_ray = ray.to_bvh(ray.t_max);
-        let mut blocked = false;
+        let mut blocker = None;
         'traversal: {
             walk!(self, bvh_ray, state, {
                 let (base, group) = take_group(&mut state);
-                if self.lanes.any_hit(base, group, ray, ray.t_max)
-                    || indices(base, self.lanes.others(base, group))
-                        .any(|index| blocks(index, ray.t_max))
-                {
-                    blocked = true;
+                blocker = self.lanes.any_hit(base, group, ray, ray.t_max).or_else(|| {
+                    indices(base, self.lanes.others(base, group))
+                        .find(|&index| blocks(index, ray.t_max))
+                });
+                if blocker.is_some() {
                     break 'traversal;
                 }
             });
         }
-        blocked
+        blocker
+    }
+
+    /// Whether primitive `index` blocks `ray` before its end, or, for a triangle, any
+    /// triangle of its run of eight (neighbours in the BVH's order, so mostly neighbours in
+    /// space). `blocks(index, t_max)` answers for the primitives that are not triangles.
+    pub(super) fn near_blocks(
+        &self,
+        index: usize,
+        ray: &Ray,
+        blocks: impl FnOnce(usize, f32) -> bool,
+    ) -> bool {
+        if self.lanes.others(index as u32, 1) != 0 {
+            blocks(index, ray.t_max)
+        } else {
+            self.lanes.run_blocks(index, ray, ray.t_max)
+        }
     }
 
     /// The nearest primitive along `ray` before its end. `hit(index, t_max)` answers for the

@@ -98,22 +98,35 @@ impl TriangleLanes {
         (low | high) as u32 & group
     }
 
-    /// Whether a triangle among `group` (bit k: primitive `base + k`) blocks `ray` before
-    /// `t_max`.
+    /// A triangle among `group` (bit k: primitive `base + k`) that blocks `ray` before
+    /// `t_max`, if any.
     #[inline]
-    pub(crate) fn any_hit(&self, base: u32, group: u32, ray: &Ray, t_max: f32) -> bool {
+    pub(crate) fn any_hit(&self, base: u32, group: u32, ray: &Ray, t_max: f32) -> Option<usize> {
         let first_run = base as usize / LANES;
         let mut lanes = (group as u64) << (base as usize % LANES);
         let mut run = first_run;
         while lanes != 0 {
             let in_run = (lanes & 0xff) as u32;
-            if in_run != 0 && self.runs[run].hits(ray, t_max).lanes & in_run != 0 {
-                return true;
+            let hit = if in_run != 0 {
+                self.runs[run].hits(ray, t_max).lanes & in_run
+            } else {
+                0
+            };
+            if hit != 0 {
+                return Some(run * LANES + hit.trailing_zeros() as usize);
             }
             lanes >>= LANES;
             run += 1;
         }
-        false
+        None
+    }
+
+    /// Whether a triangle of the run that holds primitive `index` (its seven neighbours in
+    /// BVH order, and itself) blocks `ray` before `t_max`. Slots without a triangle hold a
+    /// degenerate one that no ray hits.
+    #[inline]
+    pub(crate) fn run_blocks(&self, index: usize, ray: &Ray, t_max: f32) -> bool {
+        self.runs[index / LANES].hits(ray, t_max).lanes != 0
     }
 
     /// The nearest triangle among `group` (bit k: primitive `base + k`) that `ray` hits
@@ -267,7 +280,7 @@ mod tests {
                 expected.map(|h| h.barycentrics)
             );
             assert_eq!(
-                lanes.any_hit(base, group, &ray, ray.t_max),
+                lanes.any_hit(base, group, &ray, ray.t_max).is_some(),
                 expected.is_some()
             );
             hits += expected.is_some() as usize;

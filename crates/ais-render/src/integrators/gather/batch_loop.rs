@@ -8,6 +8,7 @@ use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, Shadow
 use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
 use super::strategy::{GatherPoint, MisParts};
+use crate::geometry::LastBlocker;
 use crate::lights::{luminance, Draw, EnvironmentDraws, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
@@ -153,6 +154,7 @@ fn run_ahead(
     let mut weights = [1.0; AHEAD];
     let mut blocked = [None; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
+    let mut last_blocker = LastBlocker::default();
     loop {
         let count = draw_ahead(run, batch, &mut drawn, &mut weights);
         if count == 0 {
@@ -160,7 +162,7 @@ fn run_ahead(
         }
         // Every slot up to `count` holds a drawn candidate.
         for (toward, blocked) in drawn[..count].iter_mut().flatten().zip(&mut blocked) {
-            *blocked = trace_aimed(run.world, run.at, toward, counts);
+            *blocked = trace_aimed(run.world, run.at, toward, counts, &mut last_blocker);
         }
         // The free rays' radiance looked up for all of them first: the lookups overlap.
         let looked_up = drawn[..count].iter_mut().flatten().zip(&blocked);
@@ -243,6 +245,7 @@ fn run_one_by_one<P: BatchProbe>(
     let at = run.at;
     let value_only = batch.map().is_none() && batch.observations().is_none();
     let mut values = RunningMean::default();
+    let mut last_blocker = LastBlocker::default();
     while let Some(candidate) = batch.next_candidate() {
         let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
             probe.decided(at.frame.normal, false);
@@ -255,9 +258,9 @@ fn run_one_by_one<P: BatchProbe>(
         if let Decision::Trace { weight } = decision {
             let started = run.clock.map(|_| Instant::now());
             let traced = if value_only && known.is_none() {
-                traced_value(run, toward, counts)
+                traced_value(run, toward, counts, &mut last_blocker)
             } else {
-                trace(run, toward, known, counts)
+                trace(run, toward, known, counts, &mut last_blocker)
             };
             record(run, batch, lessons, &mut toward, &traced, weight);
             if let (Some(clock), Some(started)) = (run.clock, started) {
@@ -386,9 +389,15 @@ struct Traced {
 /// Traces an accepted candidate whose value alone is wanted (with whether its ray was
 /// free, for a recorder): the density, the BSDF and the environment's radiance are looked
 /// up only if its shadow ray is free. The same value as [`trace`] gives; the rating is 0,
-/// as nothing reads it (the batch has no map to learn).
-fn traced_value(run: &BatchRun, mut toward: Toward, counts: &mut RayCounts) -> Traced {
-    let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts);
+/// as nothing reads it (the batch has no map to learn). `last` remembers the gather's last
+/// blocker ([`LastBlocker`]).
+fn traced_value(
+    run: &BatchRun,
+    mut toward: Toward,
+    counts: &mut RayCounts,
+    last: &mut LastBlocker,
+) -> Traced {
+    let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts, last);
     value_of(run, &mut toward, shadow_ray)
 }
 
@@ -427,12 +436,14 @@ fn value_of(run: &BatchRun, toward: &mut Toward, shadow_ray: ShadowRay) -> Trace
     }
 }
 
-/// Traces an accepted candidate: its contribution f·L/p and what it saw.
+/// Traces an accepted candidate: its contribution f·L/p and what it saw (`last` as in
+/// [`traced_value`]).
 fn trace(
     run: &BatchRun,
     mut toward: Toward,
     known: Option<Known>,
     counts: &mut RayCounts,
+    last: &mut LastBlocker,
 ) -> Traced {
     let at = run.at;
     let Known {
@@ -452,7 +463,7 @@ fn trace(
             parts: None,
         };
     }
-    let actual = leaving.trace(run.world, counts);
+    let actual = leaving.trace(run.world, counts, last);
     let rating = rating(luminance(actual), luminance(leaving.unoccluded));
     Traced {
         value: at.scattering(&toward) * actual / pdf as f32,

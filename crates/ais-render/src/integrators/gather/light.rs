@@ -2,7 +2,7 @@
 //! nothing in the way, and what the occlusion ray lets through.
 
 use super::strategy::GatherPoint;
-use crate::geometry::{spawn_ray, spawn_ray_to, Ray};
+use crate::geometry::{spawn_ray, spawn_ray_to, LastBlocker, Ray};
 use crate::lights::{Aim, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
@@ -27,16 +27,17 @@ impl Leaving {
         Leaving { ray, unoccluded }
     }
 
-    /// What the ray actually brings: its unoccluded radiance, or zero if blocked. Only rays
-    /// that could bring light are traced (and counted).
-    pub fn trace(self, world: &World, counts: &mut RayCounts) -> Vec3 {
+    /// What the ray actually brings: its unoccluded radiance, or zero if blocked, tried
+    /// first near what blocked the gather's last blocked ray (`last`). Only rays that could
+    /// bring light are traced (and counted).
+    pub fn trace(self, world: &World, counts: &mut RayCounts, last: &mut LastBlocker) -> Vec3 {
         // A ray whose unoccluded radiance is zero brings zero whatever blocks it.
         if self.unoccluded == Vec3::ZERO {
             return Vec3::ZERO;
         }
         let ray = self.ray;
         counts.occlusion += 1;
-        if world.geometry.occluded(&ray) {
+        if world.geometry.occluded_after(&ray, last) {
             Vec3::ZERO
         } else {
             self.unoccluded
@@ -70,26 +71,29 @@ pub enum ShadowRay {
 /// The radiance a candidate brings if its shadow ray is free. The ray is traced before the
 /// radiance is looked up (for the environment, a texture lookup), which a blocked ray does
 /// not need; so a ray toward a black part of the environment is traced (and counted),
-/// where [`Leaving`] would know not to.
+/// where [`Leaving`] would know not to. `last` as in [`trace_aimed`].
 pub fn free_radiance(
     world: &World,
     at: &GatherPoint,
     toward: &mut Toward,
     counts: &mut RayCounts,
+    last: &mut LastBlocker,
 ) -> ShadowRay {
-    let blocked = trace_aimed(world, at, toward, counts);
+    let blocked = trace_aimed(world, at, toward, counts, last);
     radiance_if_free(world, at, toward, blocked)
 }
 
 /// Whether the shadow ray of `toward` is blocked (`None`: no ray was needed, the candidate
-/// surely brings nothing). The first half of [`free_radiance`], for gathers that trace
-/// several candidates' rays before looking up what the free ones bring.
+/// surely brings nothing), tried first near what blocked the gather's last blocked ray
+/// (`last`). The first half of [`free_radiance`], for gathers that trace several
+/// candidates' rays before looking up what the free ones bring.
 #[inline]
 pub fn trace_aimed(
     world: &World,
     at: &GatherPoint,
     toward: &mut Toward,
     counts: &mut RayCounts,
+    last: &mut LastBlocker,
 ) -> Option<bool> {
     let target = match world.lights.aim(&at.receiver, toward) {
         Aim::Nothing => return None,
@@ -98,7 +102,7 @@ pub fn trace_aimed(
     };
     counts.occlusion += 1;
     let ray = shadow_ray(at, toward.direction, target);
-    Some(world.geometry.occluded(&ray))
+    Some(world.geometry.occluded_after(&ray, last))
 }
 
 /// The second half of [`free_radiance`]: what `toward` (aimed by [`trace_aimed`]) brings,
@@ -125,5 +129,5 @@ pub fn arriving_light(
     toward: &mut Toward,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    Leaving::new(world, at, toward).trace(world, counts)
+    Leaving::new(world, at, toward).trace(world, counts, &mut LastBlocker::default())
 }
