@@ -5,6 +5,7 @@ use crate::{load_world, parse_resolution, start_threads, SceneFlags, SceneReques
 use ais_render::atomic_write::OutputSet;
 use ais_render::image_io::{encode_exr, encode_png, RgbImage, WriteError};
 use ais_render::integrators::gather::field::LEAST_ROLLING_RAYS;
+use ais_render::integrators::gather::mis_share::ROLLING_MIS_SHARE;
 use ais_render::integrators::gather::race::RaceResult;
 use ais_render::integrators::gather::{GatherStats, MapSource};
 use ais_render::integrators::{AmbientOcclusion, Integrator};
@@ -393,7 +394,7 @@ fn print_field_summary(
     }
     if let Some(share) = stats.mis_share {
         println!(
-            "MIS          BSDF share {share} (auto's: learned from the first passes below 64 candidates, 0.25 from 64 on; AIS off uses 0.5)"
+            "MIS          BSDF share {share} (auto's: learned from the first passes below {LEAST_ROLLING_RAYS} candidates, {ROLLING_MIS_SHARE} from {LEAST_ROLLING_RAYS} on; AIS off uses 0.5)"
         );
     }
     if settings.map == MapSource::Field && stats.field_stood_aside && stats.field_race.is_none() {
