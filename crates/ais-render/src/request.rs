@@ -102,21 +102,7 @@ pub fn gather_settings(
         Some(plugin) if plugin.kind == "gather" => {
             GatherSettings::from_properties(plugin).map_err(at)?
         }
-        Some(plugin) => {
-            warnings.push(format!(
-                "{file}:{}: integrator \"{}\" rendered with ais's gather (MIS): direct light \
-                 only, indirect light is not computed",
-                plugin.line, plugin.kind
-            ));
-            let read = GatherSettings::from_mitsuba_integrator(plugin).map_err(at)?;
-            warnings.extend(read.ignored.into_iter().map(|(name, line)| {
-                format!(
-                    "{file}:{line}: \"{name}\" of integrator \"{}\" is ignored (the gather takes rays and strategy)",
-                    plugin.kind
-                )
-            }));
-            read.settings
-        }
+        Some(plugin) => mitsuba_integrator_settings(plugin, &file, warnings).map_err(at)?,
         None => GatherSettings::default(),
     };
     if let Some(unknown) = overrides.iter().find(|o| !PARAMETERS.contains(&o.name)) {
@@ -134,23 +120,43 @@ pub fn gather_settings(
         }
     }
     settings.validate()?;
+    // Each parameter given, by the scene (with its line) or by an override.
     let scene_given = integrator
         .filter(|plugin| plugin.kind == "gather")
         .into_iter()
         .flat_map(|plugin| plugin.properties.iter())
         .map(|(name, property)| {
-            (
-                name.as_str(),
-                format!("{file}:{}: \"{name}\"", property.line),
-            )
+            let said = format!("{file}:{}: \"{name}\"", property.line);
+            (name.as_str(), said)
         });
     let flag_given = overrides.iter().map(|o| (o.name, spell(o.name)));
-    for (name, said) in scene_given.chain(flag_given) {
-        if let Some(why) = settings.inapplicable(name) {
-            warnings.push(format!("{said} is ignored: {why}"));
-        }
-    }
+    warnings.extend(scene_given.chain(flag_given).filter_map(|(name, said)| {
+        let why = settings.inapplicable(name)?;
+        Some(format!("{said} is ignored: {why}"))
+    }));
     Ok(settings)
+}
+
+/// The settings for a scene whose integrator is Mitsuba's (`direct`, `path`), with a
+/// warning that it renders as the gather and one for each property the gather ignores.
+fn mitsuba_integrator_settings(
+    plugin: &Plugin,
+    file: &impl std::fmt::Display,
+    warnings: &mut Vec<String>,
+) -> Result<GatherSettings, (u32, String)> {
+    warnings.push(format!(
+        "{file}:{}: integrator \"{}\" rendered with ais's gather (MIS): direct light \
+         only, indirect light is not computed",
+        plugin.line, plugin.kind
+    ));
+    let read = GatherSettings::from_mitsuba_integrator(plugin)?;
+    warnings.extend(read.ignored.into_iter().map(|(name, line)| {
+        format!(
+            "{file}:{line}: \"{name}\" of integrator \"{}\" is ignored (the gather takes rays and strategy)",
+            plugin.kind
+        )
+    }));
+    Ok(read.settings)
 }
 
 /// The integrator that renders: Mitsuba's `moment` and `aov` wrap another, which renders
