@@ -183,8 +183,7 @@ impl<P: BatchProbe> GatherTile<P> {
         let has_use = field && field::field_has_use(world, settings);
         let mis = has_use && settings.strategy == Strategy::Mis;
         let learns_share = mis && !rolls;
-        // (Only where the field guides light sampling: that is what the share was measured
-        // for.)
+        // Only where the field also guides light sampling, as the share was measured.
         let guided = field::field_can_guide(world, settings);
         let fixed_share = (mis && rolls && guided).then_some(mis_share::ROLLING_MIS_SHARE);
         let race_pass = tile.learns && race::RACE_PASSES.contains(&learning.passes_ended());
