@@ -18,6 +18,8 @@ use crate::rng::Pcg32;
 const DIGITS_BASE3: usize = 21;
 /// Number of base-5 digits needed to represent any `u32` index.
 const DIGITS_BASE5: usize = 14;
+/// Powers `BASE^-j` kept per base: `j` up to the most digits of any base.
+const POWERS: usize = DIGITS_BASE3 + 1;
 
 /// Largest `f32` below 1: scrambled values are clamped to it so that they stay in [0, 1).
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
@@ -29,6 +31,8 @@ struct DigitScramble<const BASE: usize, const DIGITS: usize> {
     permutations: [[u8; BASE]; DIGITS],
     /// `tail[j]` = sum over positions `k >= j` of `permutation[k][0] * BASE^-(k+1)`.
     tail: [f64; DIGITS],
+    /// `BASE^-j` for `j` in `0..POWERS` (`DIGITS < POWERS`), worked out once (a scramble per epoch reads them).
+    inverse_powers: [f64; POWERS],
 }
 
 impl<const BASE: usize, const DIGITS: usize> DigitScramble<BASE, DIGITS> {
@@ -37,31 +41,35 @@ impl<const BASE: usize, const DIGITS: usize> DigitScramble<BASE, DIGITS> {
         for (digit, slot) in identity.iter_mut().enumerate() {
             *slot = digit as u8;
         }
+        let inverse_base = 1.0 / BASE as f64;
         DigitScramble {
             permutations: [identity; DIGITS],
             tail: [0.0; DIGITS],
+            inverse_powers: std::array::from_fn(|j| inverse_base.powi(j as i32)),
         }
     }
 
     /// Draws the permutations of the first `used` digit positions, and for the positions
     /// beyond (where every index of the epoch has the digit 0) only what they add: the
     /// permuted zeros, a uniform offset below `BASE^-used` (the limit of drawing each of them).
+    /// Positions from `used` on keep whatever they held: no index below the epoch's count
+    /// reads them.
     fn randomize(&mut self, rng: &mut Pcg32, used: usize) {
         let used = used.min(DIGITS);
         for permutation in self.permutations[..used].iter_mut() {
-            // Fisher-Yates shuffle of the digits.
+            // Fisher-Yates shuffle of the digits, from the identity.
+            *permutation = std::array::from_fn(|digit| digit as u8);
             for i in (1..BASE).rev() {
                 let j = rng.below(i as u32 + 1) as usize;
                 permutation.swap(i, j);
             }
         }
-        let inverse_base = 1.0 / BASE as f64;
-        let mut sum = rng.next_f64() * inverse_base.powi(used as i32);
+        let mut sum = rng.next_f64() * self.inverse_powers[used];
         if used < DIGITS {
             self.tail[used] = sum;
         }
         for position in (0..used).rev() {
-            sum += self.permutations[position][0] as f64 * inverse_base.powi(position as i32 + 1);
+            sum += self.permutations[position][0] as f64 * self.inverse_powers[position + 1];
             self.tail[position] = sum;
         }
     }
@@ -138,12 +146,10 @@ impl ScrambledHalton {
     pub fn rescramble(&mut self, seed: u64, count: u32) {
         let mut rng = Pcg32::new(seed, 0x4841_4c54_4f4e); // stream "HALTON"
         self.base2_mask = rng.next_u32();
-        self.base3 = DigitScramble::identity();
         self.base3.randomize(
             &mut rng,
             DigitScramble::<3, DIGITS_BASE3>::digits_for(count),
         );
-        self.base5 = DigitScramble::identity();
         self.base5.randomize(
             &mut rng,
             DigitScramble::<5, DIGITS_BASE5>::digits_for(count),
