@@ -1153,3 +1153,67 @@ fn disk_and_cylinder_light_sampling_fits() {
         assert!(p > SIGNIFICANCE, "light {k}: p = {p}");
     }
 }
+
+/// A receiver that only reflects leaves undrawn the lights wholly behind its plane, and
+/// only those: wherever it draws nothing and a plain receiver draws, the plain draw lies
+/// below the plane; wherever both draw, they draw the same. Random spheres and rectangles
+/// around random planes, many of them straddling the plane.
+#[test]
+fn lights_wholly_behind_a_reflecting_receiver_are_not_drawn() {
+    let mut rng = Pcg32::new(41, 7);
+    let vector = |rng: &mut Pcg32, scale: f32| {
+        Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 * scale - scale
+    };
+    let (mut skipped, mut drawn) = (0, 0);
+    for case in 0..400 {
+        let side = vector(&mut rng, 1.0).normalize();
+        let light = if case % 2 == 0 {
+            let sphere = Sphere {
+                center: vector(&mut rng, 2.0),
+                radius: 0.05 + vector(&mut rng, 0.5).x.abs(),
+            };
+            AreaShape::Sphere {
+                sphere,
+                flipped: false,
+            }
+        } else {
+            let edge_x = vector(&mut rng, 1.0);
+            let edge_y = edge_x.cross(vector(&mut rng, 1.0));
+            let rectangle = Rectangle::new(vector(&mut rng, 2.0), edge_x, edge_y, false);
+            AreaShape::Rectangle(rectangle.expect("orthogonal edges"))
+        };
+        let light = AreaLight {
+            shape: light,
+            radiance: Vec3::ONE,
+            texture: None,
+            shape_index: 0,
+        };
+        let plain = Receiver::new(Vec3::ZERO);
+        let mut reflecting = Receiver::new(Vec3::ZERO);
+        reflecting.support_side = Some(side);
+        for _ in 0..16 {
+            let u = [rng.next_f32(), rng.next_f32()];
+            let (Some(everywhere), one_side) = (
+                light.sample_for(&plain, u),
+                light.sample_for(&reflecting, u),
+            ) else {
+                continue;
+            };
+            match one_side {
+                None => {
+                    assert!(everywhere.direction.dot(side) < 0.0, "case {case}");
+                    skipped += 1;
+                }
+                Some(sample) => {
+                    assert_eq!(sample.direction, everywhere.direction, "case {case}");
+                    drawn += 1;
+                }
+            }
+        }
+    }
+    // Both kinds occur, so that the test says something about each.
+    assert!(
+        skipped > 1000 && drawn > 1000,
+        "{skipped} skipped, {drawn} drawn"
+    );
+}

@@ -85,6 +85,16 @@ impl HitBsdf<'_> {
         }
     }
 
+    /// A normal `m` such that no direction `wi` with `m · wi <= 0` lies in the support
+    /// ([`HitBsdf::in_support`]), where there is one: a single material that only reflects.
+    #[inline]
+    pub fn support_side(&self) -> Option<Vec3> {
+        match self {
+            HitBsdf::Single { material, frame } => material.support_side(frame),
+            HitBsdf::Mixture(_) => None,
+        }
+    }
+
     /// BSDF times |cos θi| (zero outside the support).
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Vec3 {

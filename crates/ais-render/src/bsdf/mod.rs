@@ -259,17 +259,28 @@ impl Material {
         .material()
     }
 
-    /// Whether `wi` can carry light to `wo` through the BSDF's continuous part: both on the
-    /// front side of the shading and geometric normals. Smooth conductors and dielectrics
-    /// have no continuous part: only their specular lobes ([`Material::sample_lobe`]) carry.
-    pub fn in_support(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> bool {
-        let transmits = match &self.scattering {
+    /// Whether light can pass through the surface (a continuous transmission lobe).
+    fn transmits(&self) -> bool {
+        match &self.scattering {
             Scattering::RoughDielectric(_) => true,
             Scattering::Principled(principled) => principled.transmits(),
             Scattering::PrincipledThin(thin) => thin.transmits(),
             _ => false,
-        };
-        if transmits {
+        }
+    }
+
+    /// A normal `m` such that no direction `wi` with `m · wi <= 0` lies in the support
+    /// ([`Material::in_support`]): the geometric normal of a surface that only reflects, or
+    /// `None` for one that transmits.
+    pub fn support_side(&self, frame: &ShadingFrame) -> Option<Vec3> {
+        (!self.transmits()).then_some(frame.geometric)
+    }
+
+    /// Whether `wi` can carry light to `wo` through the BSDF's continuous part: both on the
+    /// front side of the shading and geometric normals. Smooth conductors and dielectrics
+    /// have no continuous part: only their specular lobes ([`Material::sample_lobe`]) carry.
+    pub fn in_support(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> bool {
+        if self.transmits() {
             // Either side, where the shading and geometric normals agree on it.
             let agrees = |w: Vec3| frame.normal.dot(w) * frame.geometric.dot(w) > 0.0;
             return agrees(wo) && agrees(wi);

@@ -14,6 +14,10 @@ use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
 use std::sync::Arc;
 
+/// How far below a receiver's plane (a cosine) a light must lie to be left undrawn: f32
+/// draws toward it come out within 1e-6 of their exact direction, far inside this.
+const BEHIND_MARGIN: f32 = 1e-4;
+
 /// The emitting surface.
 #[derive(Clone, Debug)]
 pub enum AreaShape {
@@ -210,6 +214,13 @@ impl AreaLight {
     #[inline]
     pub fn sample_for(&self, receiver: &Receiver, u: [f32; 2]) -> Option<AreaSample> {
         let point = receiver.point;
+        if receiver
+            .support_side
+            .is_some_and(|side| self.wholly_behind(point, side))
+        {
+            // Every draw would fall outside the receiver's support.
+            return None;
+        }
         match &self.shape {
             AreaShape::Sphere { sphere, flipped } => {
                 let cone = SphereView::new(sphere, point)?;
@@ -377,6 +388,32 @@ impl AreaLight {
                 receiver.with_rectangle_view(rectangle, |view| Rectangle::square_of(view, offset))
             }
             _ => None,
+        }
+    }
+
+    /// Whether every direction from `point` toward the light makes a cosine below
+    /// −[`BEHIND_MARGIN`] with `side`: clearly below the plane, so that no draw's rounding
+    /// can bring it above. Only spheres and rectangles are checked (others: false).
+    fn wholly_behind(&self, point: Vec3, side: Vec3) -> bool {
+        let below = |offset: Vec3| offset.dot(side) < -BEHIND_MARGIN * offset.length();
+        match &self.shape {
+            AreaShape::Sphere { sphere, .. } => {
+                // The sphere's nearest approach to the plane, with the margin on its radius.
+                let centre = sphere.center - point;
+                centre.dot(side) + sphere.radius < -BEHIND_MARGIN * centre.length()
+            }
+            AreaShape::Rectangle(r) => {
+                let corner = r.corner - point;
+                [
+                    corner,
+                    corner + r.edge_x,
+                    corner + r.edge_y,
+                    corner + r.edge_x + r.edge_y,
+                ]
+                .into_iter()
+                .all(below)
+            }
+            AreaShape::Quadric { .. } | AreaShape::Triangles(_) => false,
         }
     }
 

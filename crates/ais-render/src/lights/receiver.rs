@@ -31,6 +31,10 @@ pub struct Receiver<'a> {
     /// Light sampling draws area light `l`'s sample square from `region_choices[l]` where
     /// that is given (a field cell's learned regions), else uniformly.
     pub region_choices: &'a [Option<RegionChoice>],
+    /// A normal `m` such that no direction `w` with `m · w <= 0` can carry light to the
+    /// viewer (the surface's BSDF only reflects), where known: lights wholly on the other
+    /// side are not drawn.
+    pub support_side: Option<Vec3>,
     views: [ViewSlot; VIEW_SLOTS],
 }
 
@@ -42,6 +46,7 @@ impl<'a> Receiver<'a> {
             environment_guide: None,
             light_choice: None,
             region_choices: &[],
+            support_side: None,
             views: Default::default(),
         }
     }

@@ -80,8 +80,10 @@ pub fn gather_point<'a>(world: &'a World, hit: &Hit, wo: Vec3) -> GatherPoint<'a
         attributes: world.geometry.attribute_site(hit),
     };
     let (bsdf, frame) = world.surfaces[hit.shape as usize].at(&point);
+    let mut receiver = Receiver::new(hit.point);
+    receiver.support_side = bsdf.support_side();
     GatherPoint {
-        receiver: Receiver::new(hit.point),
+        receiver,
         frame,
         wo,
         bsdf,
