@@ -14,7 +14,7 @@
 //!
 //! In a cell whose texels the field knows, the environment is drawn from a defensive
 //! mixture of its own distribution (in front of the surface, where the cell knows its
-//! normal) and its exact product with the cell's texel
+//! normal) and its exact product with the square roots of the cell's texel
 //! visibilities ([`EnvironmentGuide`] on the field's octahedral texels), each times the
 //! cosine between the cell's mean normal and the texel: the sky that the cell sees through
 //! a window gets the samples that the walls around it would have blocked, and more of them
@@ -273,11 +273,11 @@ pub const LEAST_SOURCE_VISIBILITY: f64 = 0.01;
 /// the cell sees but no ray tried keeps a chance beyond the defensive share.
 pub const UNSEEN_TEXEL_SHARE: f32 = 0.01;
 
-/// The guide of `cell`: each texel weighed by its learned visibility, pooled with its
-/// neighbours' ([`FieldCell::pooled_visibility_at`]); texels whose block no ray of the
-/// cell went to by [`UNSEEN_TEXEL_SHARE`] of the cell's. `None` where the cell has too
-/// little evidence or too little contrast, or where most of the environment's draws are
-/// free anyway.
+/// The guide of `cell`: each texel weighed by the square root of its learned visibility,
+/// pooled with its neighbours' ([`FieldCell::pooled_visibility_at`]); texels whose block no
+/// ray of the cell went to by [`UNSEEN_TEXEL_SHARE`] of the cell's visibility. `None` where
+/// the cell has too little evidence or too little contrast, or where most of the
+/// environment's draws are free anyway.
 fn build(
     partition: &Arc<EnvironmentPartition>,
     cell: &FieldCell,
@@ -312,19 +312,26 @@ fn build(
     Some(guide)
 }
 
-/// `A_t`, the product's weight of each texel of `cell`: its learned visibility, pooled
-/// with its neighbours' (texels whose block no ray of the cell went to: a hundredth of the
-/// cell's, [`UNSEEN_TEXEL_SHARE`]), times the cosine to the cell's normal where it knows
-/// one (at least [`LEAST_TEXEL_COSINE`]; behind the surface, its absolute value where rays
-/// went, as through a surface that transmits). `cosines` are [`texel_cosines`]'.
+/// `A_t`, the product's weight of each texel of `cell`: the square root of its learned
+/// visibility, pooled with its neighbours' (texels whose block no ray of the cell went to:
+/// a hundredth of the cell's visibility, [`UNSEEN_TEXEL_SHARE`]), times the cosine to the
+/// cell's normal where it knows one (at least [`LEAST_TEXEL_COSINE`]; behind the surface,
+/// its absolute value where rays went, as through a surface that transmits). `cosines` are
+/// [`texel_cosines`]'.
+///
+/// Why the square root: the guide serves every gather of the cell, and a texel's
+/// visibility `v` is the share of them (and of its directions) that see through it. Their
+/// mean second moment, Σ f² v / q over the texels, is least for `q ∝ f √v`; `q ∝ f v`
+/// starves the texels that some of the cell's points see fully (a window's edge, beside a
+/// wall), whose candidates then weigh too much there.
 fn product_weights(cell: &FieldCell, cosines: &[Option<f32>]) -> Vec<f64> {
     let unseen = UNSEEN_TEXEL_SHARE * cell.visibility();
     (cosines.iter().enumerate())
         .map(|(texel, &cosine)| {
             let weight = match (cell.pooled_visibility_at(texel), cosine) {
-                (Some(visibility), Some(c)) => visibility * c.abs().max(LEAST_TEXEL_COSINE),
+                (Some(visibility), Some(c)) => visibility.sqrt() * c.abs().max(LEAST_TEXEL_COSINE),
                 (None, Some(c)) => unseen * c.max(LEAST_TEXEL_COSINE),
-                (visibility, None) => visibility.unwrap_or(unseen),
+                (visibility, None) => visibility.map_or(unseen, f32::sqrt),
             };
             weight as f64
         })
@@ -421,5 +428,40 @@ mod tests {
         let (field, key) = cell_under_a_roof(false);
         let cell = field.cell(&key).unwrap();
         assert!(light_choice(&[0.99, 0.01], &[0..1, 1..2], &cell, 0.75).is_none());
+    }
+
+    /// A texel that a quarter of the cell's rays found free gets half the weight of one
+    /// they all found free (the square root of its visibility, the share that minimises
+    /// the cell's second moment), not a quarter.
+    #[test]
+    fn a_texel_weighs_the_square_root_of_its_visibility() {
+        let key = CellKey::new([0.0, 0.0, 0.0], [0.0, 0.0, 1.0], 0);
+        let mut observations = FieldObservations::new(4);
+        let mut cell = observations.cell_mut(key);
+        for ray in 0..400 {
+            cell.record([0.0, 0.0, 1.0], ray % 4 == 0);
+            cell.record([0.0, 0.0, -1.0], true);
+        }
+        let mut field = VisibilityField::new(4);
+        field.merge(&observations);
+        let cell = field.cell(&key).unwrap();
+        let side = cell.side();
+        let (up, down) = (
+            octahedral::texel_of([0.0, 0.0, 1.0], side),
+            octahedral::texel_of([0.0, 0.0, -1.0], side),
+        );
+        let (v_up, v_down) = (
+            cell.pooled_visibility_at(up).expect("seen"),
+            cell.pooled_visibility_at(down).expect("seen"),
+        );
+        assert!(v_up < 0.5 * v_down, "visibilities {v_up} and {v_down}");
+        // Without a normal, the weights are the visibilities' square roots alone.
+        let weights = product_weights(&cell, &vec![None; (side * side) as usize]);
+        let ratio = weights[up as usize] / weights[down as usize];
+        let expected = (v_up as f64 / v_down as f64).sqrt();
+        assert!(
+            (ratio - expected).abs() < 1e-6,
+            "{ratio} against {expected}"
+        );
     }
 }
