@@ -457,7 +457,7 @@ mod tests {
         assert!(v_up < 0.5 * v_down, "visibilities {v_up} and {v_down}");
         // Without a normal, the weights are the visibilities' square roots alone.
         let weights = product_weights(&cell, &vec![None; (side * side) as usize]);
-        let ratio = weights[up as usize] / weights[down as usize];
+        let ratio = weights[up] / weights[down];
         let expected = (v_up as f64 / v_down as f64).sqrt();
         assert!(
             (ratio - expected).abs() < 1e-6,
