@@ -39,10 +39,11 @@ pub const MIS_SHARES: [f64; 4] = [0.125, 0.25, 0.5, 0.75];
 /// sampling, where no share is learned: light sampling, guided by a field taught from the
 /// first passes, is the better of the two strategies there, and the BSDF's draws the
 /// defensive part. Pinned at n = 128 and measured by `ais compare` (equal time, 3 s, a
-/// field taught as a render's is), 0.25 against 0.5 gained 1.51× on the default scene, 1.26× behind a roof edge,
-/// 1.24× in the foliage and 1.11× in the courtyard, tied in four more scenes and lost 3% in
-/// the overcast room and 20% in the sunlit room; 0.75 lost or tied everywhere (the
-/// repository's BENCHMARKS.md, section 5.6). A share learned from the candidates' moments
+/// field taught as a render's is), 0.25 against 0.5 gained 1.51× on the default scene,
+/// 1.26× behind a roof edge, 1.24× in the foliage and 1.11× in the courtyard, tied in four
+/// more scenes and lost 3% in the overcast room and 20% in the sunlit room (measured
+/// before guides weighed the square root of a texel's visibility); 0.75 lost or tied
+/// everywhere (the repository's BENCHMARKS.md, section 5.6). A share learned from the candidates' moments
 /// lost in the rooms there, and one raced in the race passes chose by a field too young.
 pub const ROLLING_MIS_SHARE: f64 = 0.25;
 
