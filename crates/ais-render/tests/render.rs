@@ -2,7 +2,8 @@
 //! model from npm (the Stanford bunny).
 
 use ais_render::default_scene::default_world;
-use ais_render::film::ReconstructionFilter;
+use ais_render::film::{Film, ReconstructionFilter};
+use ais_render::image_io::RgbImage;
 use ais_render::integrators::gather::mis_share::ROLLING_MIS_SHARE;
 use ais_render::integrators::gather::{self, GatherStats};
 use ais_render::integrators::gather::{Acceptance, GatherSettings, MapUse, Preset, Sharing};
@@ -136,6 +137,58 @@ fn a_wide_filter_keeps_crops_and_threads_exact() {
         );
     }
     thread_independent(&world, GatherSettings::preset(Preset::Shared));
+}
+
+/// Renders of `passes` one-sample passes that continue one another, combined by adding
+/// their films, and by averaging their images.
+fn progressive_normals(world: &World, passes: u32) -> (RgbImage, RgbImage) {
+    let mut film = Film::new(world.resolution.0 as usize, world.resolution.1 as usize);
+    let mut averaged = vec![[0.0f64; 3]; film.image().pixels.len()];
+    for first_sample in 0..passes {
+        let pass = RenderSettings {
+            first_sample,
+            ..settings(1)
+        };
+        let output = render(world, &Integrator::Normals, &pass);
+        film.add_film(&output.film);
+        for (sum, pixel) in averaged.iter_mut().zip(&output.image.pixels) {
+            for c in 0..3 {
+                sum[c] += pixel[c] as f64 / passes as f64;
+            }
+        }
+    }
+    let mut averaged_image = film.image();
+    for (pixel, sum) in averaged_image.pixels.iter_mut().zip(&averaged) {
+        *pixel = sum.map(|v| v as f32);
+    }
+    (film.image(), averaged_image)
+}
+
+#[test]
+fn passes_whose_films_are_added_equal_one_render_of_their_samples() {
+    // The normals depend on the camera samples alone, and those on their rank: one render
+    // of 8 samples and 8 one-sample passes see the same rays.
+    let mut world = default_world(48, 27);
+    world.filter = ReconstructionFilter::MITSUBA_DEFAULT;
+    let whole = render(&world, &Integrator::Normals, &settings(8)).image;
+    let (added, averaged) = progressive_normals(&world, 8);
+    let largest_difference = |image: &RgbImage| {
+        image
+            .pixels
+            .iter()
+            .flatten()
+            .zip(whole.pixels.iter().flatten())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0f32, f32::max)
+    };
+    assert!(
+        largest_difference(&added) < 1e-5,
+        "{}",
+        largest_difference(&added)
+    );
+    // Averaging the passes' images is another estimator: a pixel is a ratio of weighted
+    // sums, and at the sculpture's edges the mean of one-sample ratios is not the ratio.
+    assert!(largest_difference(&averaged) > 1e-2);
 }
 
 #[test]

@@ -56,6 +56,13 @@ pub struct RenderSettings {
 pub struct RenderOutput<S> {
     /// The image.
     pub image: RgbImage,
+    /// The weighted sums the image was developed from, over the pixels rendered. Renders
+    /// that continue one another (a progressive study's passes) are combined by adding their
+    /// films ([`Film::add_film`]) and developing the sum: that is the image one render of
+    /// all their samples gives. Averaging their images instead is not, where a filter wider
+    /// than a pixel splats: a pixel's value is a ratio of sums, and the mean of few-sample
+    /// ratios is noisier, and biased, at edges.
+    pub film: Film,
     /// Rays traced.
     pub rays: RayCounts,
     /// The integrator's statistics, merged over tiles.
@@ -72,6 +79,7 @@ impl<S> RenderOutput<S> {
     pub fn map_stats<T>(self, f: impl FnOnce(S) -> T) -> RenderOutput<T> {
         RenderOutput {
             image: self.image,
+            film: self.film,
             rays: self.rays,
             stats: f(self.stats),
             work_per_sample: self.work_per_sample,
@@ -221,6 +229,7 @@ fn render_passes<I: SampleIntegrator>(
     progress.finish_and_clear();
     RenderOutput {
         image: output.film.image_of(region),
+        film: output.film,
         rays: output.rays,
         stats: output.stats,
         work_per_sample: output.work_per_sample,

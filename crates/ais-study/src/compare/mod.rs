@@ -19,6 +19,7 @@ pub mod summary;
 
 use crate::oracle::Oracle;
 use ais::rng::mix64;
+use ais_render::film::Film;
 use ais_render::image_io::RgbImage;
 use ais_render::integrators::gather::{
     GatherLearning, GatherSettings, GatherStats, Preset, Strategy,
@@ -106,7 +107,7 @@ impl Configuration {
                 .map_stats(|_| GatherStats::default()),
         };
         Pass {
-            image: output.image,
+            film: output.film,
             seconds: output.time.as_secs_f64(),
             rays: output.rays,
             stats: output.stats.ais,
@@ -117,8 +118,8 @@ impl Configuration {
 
 /// What one rendered pass gives a study.
 pub struct Pass {
-    /// The image.
-    pub image: RgbImage,
+    /// Its film (weighted sums: passes add up by [`Film::add_film`]).
+    pub film: Film,
     /// Its render time.
     pub seconds: f64,
     /// Rays traced.
@@ -294,8 +295,9 @@ fn progressive(
     (seed, pass_spp): (u64, u32),
     budget: Budget,
 ) -> Run {
-    let pixels = reference.image.pixels.len();
-    let mut sum = vec![[0.0f64; 3]; pixels];
+    let (width, height) = (reference.image.width, reference.image.height);
+    // The passes' films add up to the film of one render of all their samples.
+    let mut film = Film::new(width, height);
     let mut run = Run {
         image: reference.image.clone(),
         spp: 0,
@@ -313,19 +315,13 @@ fn progressive(
             count: pass_spp,
         };
         let output = configuration.render_pass(world, samples, seed, &mut learned);
-        for (s, p) in sum.iter_mut().zip(&output.image.pixels) {
-            for c in 0..3 {
-                s[c] += p[c] as f64 * pass_spp as f64;
-            }
-        }
+        film.add_film(&output.film);
         run.spp += pass_spp;
         run.seconds += output.seconds;
         run.rays.merge(output.rays);
         run.stats.merge(&output.stats);
         run.ais_memory_per_thread = run.ais_memory_per_thread.max(output.ais_memory_per_thread);
-        for (pixel, s) in run.image.pixels.iter_mut().zip(&sum) {
-            *pixel = s.map(|v| (v / run.spp as f64) as f32);
-        }
+        run.image = film.image();
         run.curve.push(CurvePoint {
             seconds: run.seconds,
             rays: run.rays.total(),

@@ -1,6 +1,7 @@
 //! The converged reference of a study, cached on disk by a hash of what determines it.
 
 use super::metrics::{rel_mse, RELMSE_EPSILON};
+use ais_render::film::Film;
 use ais_render::image_io::{read_image, write_exr, RgbImage};
 use ais_render::integrators::gather::{GatherSettings, Preset, Strategy};
 use ais_render::integrators::Integrator;
@@ -73,7 +74,8 @@ fn render_half(
     progress: &ProgressBar,
 ) -> RgbImage {
     let (width, height) = (world.resolution.0 as usize, world.resolution.1 as usize);
-    let mut sum = vec![[0.0f64; 3]; width * height];
+    // The chunks' films add up to the film of one render of all their samples.
+    let mut film = Film::new(width, height);
     let mut done = 0;
     while done < spp {
         let chunk = CHUNK.min(spp - done);
@@ -88,22 +90,11 @@ fn render_half(
                 crop: None,
             },
         );
-        for (s, p) in sum.iter_mut().zip(&output.image.pixels) {
-            for c in 0..3 {
-                s[c] += p[c] as f64 * chunk as f64;
-            }
-        }
+        film.add_film(&output.film);
         done += chunk;
         progress.inc(chunk as u64);
     }
-    RgbImage {
-        width,
-        height,
-        pixels: sum
-            .iter()
-            .map(|s| s.map(|v| (v / spp as f64) as f32))
-            .collect(),
-    }
+    film.image()
 }
 
 /// The reference: the gather with MIS and AIS off at `spp` samples per pixel (two

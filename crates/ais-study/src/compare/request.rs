@@ -118,7 +118,7 @@ impl CompareRequest<'_> {
             self.reference_spp,
             rays,
             env!("CARGO_PKG_VERSION"),
-            "reference v2"
+            "reference v3"
         ))
     }
 
