@@ -77,8 +77,8 @@ pub struct GatherFlags {
     #[arg(long)]
     field_race: Option<String>,
     /// map field: "false" keeps --rays candidates in every gather; "true" (the default)
-    /// lets the race give fewer (down to n/8, at least 4) to 16 × 16-pixel blocks whose noise is mostly
-    /// what the camera sees, for more camera samples in the same time.
+    /// lets the race give fewer (down to n/8, at least 4) to 16 × 16-pixel blocks whose
+    /// gathers vary little, for more samples in the same time.
     #[arg(long)]
     field_sizes: Option<String>,
     /// Mitsuba's hide_emitters: "true" hides the emitters the camera sees directly.

@@ -467,9 +467,9 @@ fn the_field_is_unbiased_in_rooms_lit_through_windows() {
 
 #[test]
 fn gathers_with_the_sizes_the_race_chose_are_unbiased() {
-    // Two rooms at 48 × 32 pixels, where what the camera sees dominates the noise: after
-    // the race passes (4 samples) the other 28 gather with fewer candidates, chosen per
-    // block. The interior is lit by a sky the field guides toward; the door gap by a
+    // Two rooms at 48 × 32 pixels, whose gathers vary much more in some blocks than in
+    // others: after the race passes (4 samples) the other 28 gather with fewer candidates
+    // where they vary little, chosen per block. The interior is lit by a sky the field guides toward; the door gap by a
     // rectangle light alone, whose regions the field weighs.
     // Emitters seen directly are hidden, so that every pixel is gathered light. The
     // image's mean agrees with AIS off's within 4 standard errors (an estimate 5% off in

@@ -111,8 +111,8 @@ pub fn field_can_guide(world: &World, settings: &GatherSettings) -> bool {
 
 /// Whether gathers with these settings measure their pixels in the race passes to choose
 /// the candidates per gather per block (`map = field` with `field_sizes`): where the field
-/// has a use and where it has none (area lights only), since what the camera sees can
-/// dominate the noise anywhere. Such renders run in passes ([`field_passes`]).
+/// has a use and where it has none (area lights only), since gathers' variance can be
+/// spread unevenly over any image. Such renders run in passes ([`field_passes`]).
 pub fn chooses_sizes(settings: &GatherSettings) -> bool {
     settings.map == MapSource::Field && settings.field_sizes
 }
