@@ -18,11 +18,11 @@
 //! **What the camera sees is left out.** A pixel's samples also vary with what their camera
 //! rays see (an edge, a light seen directly), but camera samples are stratified (an
 //! Owen-scrambled Sobol sequence per pixel), and that part of the error falls much faster
-//! than one over the samples. Counted as the variance of independent samples, it made the
-//! counts drop wherever edges were, and lost: the sphere lights among pillars came out at
-//! 0.90× of AIS off at n = 16 with it, 1.39× without it, and no scene lost from leaving it
-//! out (the repository's BENCHMARKS.md, section 5.6). A single block therefore keeps `n`:
-//! the counts follow only how the gathers' variance is spread over the image.
+//! than one over the samples, so the model leaves it out, and a single block keeps `n`: the
+//! counts follow only how the gathers' variance is spread over the image. (Measured, this
+//! changed no scene's gain beyond noise: the camera's term was small next to that spread.
+//! Where the choice loses, in the sphere lights and the foliage at n = 16, it is not the
+//! camera's term; the repository's BENCHMARKS.md, section 5.6.)
 //!
 //! **The samples already taken count.** The film averages every sample alike, so the
 //! samples taken with `n` candidates before the choice stay in the image with their
