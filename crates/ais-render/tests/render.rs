@@ -157,11 +157,12 @@ fn progressive_normals(world: &World, passes: u32) -> (RgbImage, RgbImage) {
             }
         }
     }
-    let mut averaged_image = film.image();
-    for (pixel, sum) in averaged_image.pixels.iter_mut().zip(&averaged) {
-        *pixel = sum.map(|v| v as f32);
-    }
-    (film.image(), averaged_image)
+    let added = film.image();
+    let averaged = RgbImage {
+        pixels: averaged.iter().map(|sum| sum.map(|v| v as f32)).collect(),
+        ..added
+    };
+    (added, averaged)
 }
 
 #[test]

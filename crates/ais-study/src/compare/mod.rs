@@ -299,7 +299,7 @@ fn progressive(
     // The passes' films add up to the film of one render of all their samples.
     let mut film = Film::new(width, height);
     let mut run = Run {
-        image: reference.image.clone(),
+        image: film.image(),
         spp: 0,
         seconds: 0.0,
         rays: RayCounts::default(),
