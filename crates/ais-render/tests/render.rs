@@ -451,11 +451,17 @@ fn a_field_that_loses_its_race_stands_aside_for_the_rest() {
 
 #[test]
 fn field_passes_learn_from_eight_samples_then_render_the_rest() {
-    assert_eq!(gather::field_passes(4), vec![1, 1, 2]);
-    assert_eq!(gather::field_passes(64), vec![1, 1, 2, 4, 56]);
-    assert_eq!(gather::field_passes(8), vec![1, 1, 2, 4]);
-    assert_eq!(gather::field_passes(5), vec![1, 1, 2, 1]);
-    assert_eq!(gather::field_passes(1), vec![1]);
+    assert_eq!(gather::field_passes(0, 4), vec![1, 1, 2]);
+    assert_eq!(gather::field_passes(0, 64), vec![1, 1, 2, 4, 56]);
+    assert_eq!(gather::field_passes(0, 8), vec![1, 1, 2, 4]);
+    assert_eq!(gather::field_passes(0, 5), vec![1, 1, 2, 1]);
+    assert_eq!(gather::field_passes(0, 1), vec![1]);
+    assert_eq!(gather::field_passes(0, 0), Vec::<u32>::new());
+    // A render that goes on from earlier ones ends its passes where a whole render would.
+    assert_eq!(gather::field_passes(2, 2), vec![2]);
+    assert_eq!(gather::field_passes(3, 1), vec![1]);
+    assert_eq!(gather::field_passes(2, 10), vec![2, 4, 4]);
+    assert_eq!(gather::field_passes(8, 4), vec![4]);
 }
 
 #[test]

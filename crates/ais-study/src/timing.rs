@@ -170,8 +170,8 @@ impl SampleIntegrator for TimedGather {
     type Learned = GatherLearning;
     type Tile = TimedTile;
 
-    fn passes(&self, world: &World, spp: u32) -> Vec<u32> {
-        Integrator::Gather(self.0).passes(world, spp)
+    fn passes(&self, world: &World, first_sample: u32, spp: u32) -> Vec<u32> {
+        Integrator::Gather(self.0).passes(world, first_sample, spp)
     }
 
     fn new_learning(&self, world: &World) -> GatherLearning {

@@ -76,13 +76,13 @@ impl SampleIntegrator for Integrator {
     type Learned = GatherLearning;
     type Tile = IntegratorTile;
 
-    fn passes(&self, world: &World, spp: u32) -> Vec<u32> {
+    fn passes(&self, world: &World, first_sample: u32, spp: u32) -> Vec<u32> {
         match self {
             Integrator::Gather(settings)
                 if gather::field_has_use(world, settings)
                     || gather::field::chooses_sizes(settings) =>
             {
-                gather::field_passes(spp)
+                gather::field_passes(first_sample, spp)
             }
             _ => vec![spp],
         }

@@ -49,7 +49,7 @@ pub trait Learning: Sync {
 /// Where a render stands when a pass ends.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PassEnd {
-    /// Samples per pixel taken so far by this render.
+    /// Samples per pixel taken so far, by this render and the renders it goes on from.
     pub done: u32,
     /// Samples per pixel it has left (`None` where later renders go on from what this one
     /// learns: the end is not known).
@@ -104,8 +104,9 @@ pub trait SampleIntegrator: Sync {
     /// Per-tile state.
     type Tile: TileState;
 
-    /// How `spp` samples per pixel split into passes in `world` (one pass unless it learns).
-    fn passes(&self, _world: &World, spp: u32) -> Vec<u32> {
+    /// How `spp` samples per pixel from sample `first_sample` on split into passes in
+    /// `world` (one pass unless it learns).
+    fn passes(&self, _world: &World, _first_sample: u32, spp: u32) -> Vec<u32> {
         vec![spp]
     }
 

@@ -181,7 +181,7 @@ fn render_passes<I: SampleIntegrator>(
     // A filter wider than a pixel needs the samples of the pixels around the region too.
     let rendered = region.grown(world.filter.margin(), (width, height));
     let rects = tiles_of(rendered, (width, height));
-    let mut passes = integrator.passes(world, settings.samples_per_pixel);
+    let mut passes = integrator.passes(world, settings.first_sample, settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
     let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(region, rendered);
@@ -214,7 +214,7 @@ fn render_passes<I: SampleIntegrator>(
             learned.merge(output.add(result, samples, settings.samples_per_pixel));
         }
         learned.end_pass(PassEnd {
-            done: passes[..=index].iter().sum(),
+            done: settings.first_sample + passes[..=index].iter().sum::<u32>(),
             left: (!learning_goes_on).then(|| passes[index + 1..].iter().sum()),
         });
         if index + 2 < passes.len() && !learned.keeps_learning() {

@@ -2,8 +2,9 @@
 //! reference at equal wall time and at equal traced rays, with several seeds, and a
 //! self-contained HTML report.
 //!
-//! Each run renders progressive passes (of one sample per pixel, or
-//! [`StudySettings::pass_spp`]) until its budget is spent,
+//! Each run renders progressive passes until its budget is spent: first those a render of
+//! its own would take ([`Configuration::leading_passes`]), then passes of one sample per
+//! pixel (or [`StudySettings::pass_spp`]),
 //! recording relMSE after every pass (the convergence curves). Equal-time runs stop at the
 //! time budget; equal-ray runs stop when they have traced as many rays (camera plus gather
 //! rays) as the baseline configuration traced in its equal-time runs (median over seeds).
@@ -25,7 +26,7 @@ use ais_render::integrators::gather::{
     GatherLearning, GatherSettings, GatherStats, Preset, Strategy,
 };
 use ais_render::integrators::Integrator;
-use ais_render::render::{render, render_learning, RayCounts, RenderSettings};
+use ais_render::render::{render, render_learning, RayCounts, RenderSettings, SampleIntegrator};
 use ais_render::world::World;
 use indicatif::{MultiProgress, ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::Path;
@@ -78,6 +79,20 @@ impl Configuration {
     /// Whether this is the oracle (run at equal rays only).
     pub fn is_oracle(&self) -> bool {
         self.technique == Technique::Oracle
+    }
+
+    /// The samples per pixel of a run's first passes, as a render of its own takes them
+    /// (`ais auto`'s field learns and races in passes of 1, 1, 2 and 4): a study's run
+    /// learns, races and chooses exactly as `ais render` does. Empty where a render is one
+    /// pass.
+    pub fn leading_passes(&self, world: &World) -> Vec<u32> {
+        if self.is_oracle() {
+            return Vec::new();
+        }
+        // A render of endless samples: every pass but the last, which holds the rest.
+        let mut passes = Integrator::Gather(self.settings).passes(world, 0, u32::MAX);
+        passes.pop();
+        passes
     }
 
     /// Renders one pass of the `samples` of each pixel with `seed`, from what the run's
@@ -308,15 +323,18 @@ fn progressive(
         ais_memory_per_thread: 0,
     };
     let mut learned = GatherLearning::new(world, &configuration.settings);
+    let leading = configuration.leading_passes(world);
+    let mut pass = 0;
     loop {
         // One seed for the run: its passes continue each pixel's camera sequence.
         let samples = SampleRange {
             first: run.spp,
-            count: pass_spp,
+            count: leading.get(pass).copied().unwrap_or(pass_spp),
         };
         let output = configuration.render_pass(world, samples, seed, &mut learned);
         film.add_film(&output.film);
-        run.spp += pass_spp;
+        run.spp += samples.count;
+        pass += 1;
         run.seconds += output.seconds;
         run.rays.merge(output.rays);
         run.stats.merge(&output.stats);
