@@ -303,6 +303,19 @@ enum Budget {
     Rays(u64),
 }
 
+impl Budget {
+    /// The samples per pixel a run will have taken when this budget is spent, at the pace
+    /// of its passes so far: `spp` samples in `seconds`, tracing `rays` (`None` before any).
+    fn expected_samples(&self, spp: u32, seconds: f64, rays: u64) -> Option<u32> {
+        let share_spent = match *self {
+            Budget::Seconds(limit) => seconds / limit,
+            Budget::Rays(limit) => rays as f64 / limit as f64,
+        };
+        (spp > 0 && share_spent > 0.0)
+            .then(|| (spp as f64 / share_spent).min(MOST_PASSES as f64).round() as u32)
+    }
+}
+
 fn progressive(
     world: &World,
     configuration: &Configuration,
@@ -331,6 +344,8 @@ fn progressive(
             first: run.spp,
             count: leading.get(pass).copied().unwrap_or(pass_spp),
         };
+        // A render of its own knows its samples; a run knows its budget.
+        learned.expect_samples(budget.expected_samples(run.spp, run.seconds, run.rays.total()));
         let output = configuration.render_pass(world, samples, seed, &mut learned);
         film.add_film(&output.film);
         run.spp += samples.count;
@@ -517,4 +532,23 @@ pub fn run(world: &World, settings: &StudySettings) -> Result<StudyResults, Stri
 pub fn write_text(path: &Path, text: &str) -> Result<(), String> {
     ais_render::atomic_write::write_atomically(path, |temporary| std::fs::write(temporary, text))
         .map_err(|e: std::io::Error| format!("{}: cannot write: {e}", path.display()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_run_expects_the_samples_its_budget_buys_at_its_pace() {
+        let seconds = Budget::Seconds(3.0);
+        assert_eq!(seconds.expected_samples(0, 0.0, 0), None, "no pass yet");
+        assert_eq!(seconds.expected_samples(4, 0.5, 1000), Some(24));
+        assert_eq!(
+            Budget::Rays(10_000).expected_samples(4, 0.5, 1000),
+            Some(40)
+        );
+        // A pass that took no measurable time does not promise endless samples.
+        assert_eq!(seconds.expected_samples(4, 0.0, 1000), None);
+        assert_eq!(seconds.expected_samples(4, 1e-12, 1), Some(MOST_PASSES));
+    }
 }

@@ -260,6 +260,9 @@ pub struct GatherLearning {
     races: bool,
     /// The candidates per gather per block, once the race chose them.
     sizes: Option<Arc<GatherSizes>>,
+    /// The samples per pixel the whole render is expected to take, where its passes do not
+    /// know (a progressive study's, whose budget is in time).
+    horizon: Option<u32>,
 }
 
 impl GatherLearning {
@@ -289,7 +292,16 @@ impl GatherLearning {
             chooses_sizes: chooses_sizes(settings),
             races: races(world, settings),
             sizes: None,
+            horizon: None,
         }
+    }
+
+    /// Where a render's passes go on in later renders, the samples per pixel all of them are
+    /// expected to take (`None`: not known), for the choice of candidates per block: how
+    /// long the render is decides how much what the camera sees weighs
+    /// ([`super::gather_sizes`]).
+    pub fn expect_samples(&mut self, total: Option<u32>) {
+        self.horizon = total;
     }
 
     /// The candidates per gather per block of the image, once the race chose them (`None`:
@@ -362,6 +374,11 @@ impl GatherLearning {
         }
         let arm = self.race_result.map(|race| !race.field_pays());
         let blocks = self.race.blocks(arm);
+        let horizon = self.horizon.map(|total| total.saturating_sub(samples.done));
+        let samples = PassEnd {
+            left: samples.left.or(horizon),
+            ..samples
+        };
         let columns = GatherSizes::columns_for(self.race.width());
         self.sizes = GatherSizes::choose(&blocks, columns, self.rays, samples).map(Arc::new);
     }

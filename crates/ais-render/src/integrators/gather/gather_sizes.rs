@@ -1,40 +1,47 @@
 //! How many candidates a gather gets, per block of the image: the counts that give the
-//! least noise per unit of time, chosen from what the race passes measured.
+//! least error in the time the render takes, chosen from what the race passes measured.
 //!
-//! A gather's variance falls as `V₁ / m` with `m` candidates. A camera sample costs its own
-//! work, `ρ₀` candidates' worth, plus `m` candidates where its ray gathers (a share `g` of
-//! its samples). Over the image's blocks `b`, minimising (Σ variance) × (Σ cost) gives,
-//! setting each `m_b`'s derivative to zero,
+//! A pixel sample's variance has two parts: what its camera ray sees (which surface, which
+//! edge, a light seen directly), `V_cam`, and its gather's, which falls as `V₁ / m` with `m`
+//! candidates. A camera sample costs its own work, `ρ₀` candidates' worth, plus `m`
+//! candidates where its ray gathers (a share `g` of its samples). Fewer candidates in a
+//! block buy every pixel more samples in the same time.
 //!
-//!   m_b = λ · √(V₁,b / g_b),   λ = √(C / V),
+//! **The camera's part falls faster than one over the samples.** A pixel's camera samples
+//! are stratified (an Owen-scrambled Sobol sequence per pixel). Where a pixel holds an edge,
+//! the error of the mean of `N` stratified samples falls as `N^(-3/2)`, not `N^(-1)`, and
+//! faster where the pixel is smooth. So the image's error after `N` samples per pixel,
+//! with `m_b` candidates in block `b`, is taken as
 //!
-//! with `C` and `V` the image's cost and variance at the optimum: one scale `λ` for the
-//! image, found by scanning it. Blocks whose gathers vary little (in shadow, or lit evenly)
-//! get fewer candidates, and the time they save buys every pixel more samples; blocks whose
-//! gathers vary most keep the user's `n`. A gather never gets more than `n` (time per
-//! sample never grows) nor fewer than [`FEWEST_SHARE`] of it or [`FEWEST`], and the image
-//! keeps `n` everywhere unless the predicted gain is at least [`LEAST_GAIN`].
+//!   E = Σ_b [ V_cam,b / N^(3/2) + V₁,b / (m_b N) ],
 //!
-//! **What the camera sees is left out.** A pixel's samples also vary with what their camera
-//! rays see (an edge, a light seen directly), but camera samples are stratified (an
-//! Owen-scrambled Sobol sequence per pixel), and that part of the error falls much faster
-//! than one over the samples, so the model leaves it out, and a single block keeps `n`: the
-//! counts follow only how the gathers' variance is spread over the image. (Measured, this
-//! changed no scene's gain beyond noise: the camera's term was small next to that spread.
-//! Where the choice loses, in the sphere lights and the foliage at n = 16, it is not the
-//! camera's term; the repository's BENCHMARKS.md, section 5.6.)
+//! with `N` the samples the render's time buys at those counts. The camera's part weighs
+//! most in a short render: at a few dozen samples per pixel, fewer candidates and more
+//! camera samples pay where what the camera sees dominates (foliage, edges); at a few
+//! hundred, the gathers' part is nearly all that is left. (Counting the camera's part as
+//! that of independent samples, `V_cam / N`, gave 4× in the foliage at 128 candidates and
+//! 30 samples per pixel, but lost in the sphere lights at 16 candidates and 300; leaving it
+//! out lost the foliage's gain: the repository's BENCHMARKS.md, section 5.6.)
 //!
-//! **The samples already taken count.** The film averages every sample alike, so the
-//! samples taken with `n` candidates before the choice stay in the image with their
-//! variance and cost; with few samples left, variance added to them cannot be repaid.
-//! Where later renders go on learning, the end is open and only the per-sample optimum
-//! counts.
+//! Setting each `m_b`'s derivative to zero at a fixed time gives `m_b = λ · √(V₁,b / g_b)`,
+//! one scale `λ` for the image: blocks whose gathers vary little (in shadow, or lit evenly)
+//! get fewer candidates. `λ` is found by scanning. A gather never gets more than `n`
+//! (time per sample never grows) nor fewer than [`FEWEST_SHARE`] of it or [`FEWEST`], and
+//! the image keeps `n` everywhere unless the predicted gain is at least [`LEAST_GAIN`].
+//!
+//! **The render's length.** `N` is what the render will take: the samples done, plus those
+//! left, scaled by how much cheaper a sample gets. A render that does not know its end
+//! (later renders go on from it, with no horizon given) is taken as endless: only the
+//! gathers' spread over the image counts, and a single block keeps `n`. The film averages
+//! every sample alike, so the samples taken with `n` candidates before the choice stay in
+//! the image with their variance.
 //!
 //! `V₁` comes from the gathers' own estimate of their variance, which counts the candidates
 //! as independent: Halton's stratified candidates vary less, so the estimate is high where
-//! they stratify well. (Making each block as efficient as it can be on its own, instead of
-//! the image, almost never changed a count. One count for the whole image gained less than
-//! a count per block.)
+//! they stratify well, and `V_cam` (the pixels' sample variance less that estimate) low.
+//! (Making each block as efficient as it can be on its own, instead of the image, almost
+//! never changed a count. One count for the whole image gained less than a count per
+//! block.)
 //!
 //! The counts change only between passes and are read per pixel: each pass stays unbiased
 //! (a gather of any fixed size is), and the image does not depend on threads.
@@ -66,6 +73,8 @@ pub const LEAST_GAIN: f64 = 1.1;
 pub struct BlockMoments {
     /// Pixels measured.
     pub pixels: f64,
+    /// Σ per-sample variance of the pixels (camera and gather together).
+    pub total: f64,
     /// Σ per-sample variance of the pixels' gathers, at `n` candidates.
     pub gather: f64,
     /// Σ share of the pixels' samples whose camera ray gathered.
@@ -73,10 +82,11 @@ pub struct BlockMoments {
 }
 
 impl BlockMoments {
-    /// Adds one pixel: its gathers' weighted variance per sample, and the share of its
-    /// samples that gathered.
-    pub fn add_pixel(&mut self, gather: f64, gathered: f64) {
+    /// Adds one pixel: its weighted variance per sample, its gathers' weighted variance per
+    /// sample, and the share of its samples that gathered.
+    pub fn add_pixel(&mut self, total: f64, gather: f64, gathered: f64) {
         self.pixels += 1.0;
+        self.total += total;
         self.gather += gather;
         self.gathered += gathered;
     }
@@ -84,6 +94,16 @@ impl BlockMoments {
     /// The gathers' variance per candidate (`V₁`), from their variance at `n` candidates.
     fn per_candidate(&self, n: u32) -> f64 {
         self.gather * n as f64
+    }
+
+    /// The camera's part of the variance per sample (what no count of candidates changes).
+    fn camera(&self) -> f64 {
+        (self.total - self.gather).max(0.0)
+    }
+
+    /// A sample's cost in candidates' worth with `m` candidates per gather.
+    fn cost(&self, m: f64) -> f64 {
+        SAMPLE_COST * self.pixels + self.gathered * m
     }
 }
 
@@ -98,8 +118,9 @@ pub struct GatherSizes {
 
 impl GatherSizes {
     /// The counts for `n`-candidate gathers over blocks measured as `blocks` (row by row,
-    /// `columns` per row), the render standing at `samples`; `None` where keeping `n`
-    /// everywhere is as good (within [`LEAST_GAIN`]) or nothing was measured.
+    /// `columns` per row), the render standing at `samples` (its end as far as known);
+    /// `None` where keeping `n` everywhere is as good (within [`LEAST_GAIN`]) or nothing
+    /// was measured.
     pub fn choose(
         blocks: &[BlockMoments],
         columns: usize,
@@ -107,12 +128,12 @@ impl GatherSizes {
         samples: PassEnd,
     ) -> Option<GatherSizes> {
         let fewest = ((n as f64 * FEWEST_SHARE).ceil() as u32).max(FEWEST).min(n);
-        let kept = efficiency_cost(blocks, &vec![n; blocks.len()], n, samples)?;
+        let kept = final_error(blocks, &vec![n; blocks.len()], n, samples)?;
         // λ on a log scale (steps of 2^(1/12)) wide enough for every count from 1 to n.
         let (best, counts) = (0..=240)
             .map(|step| 2f64.powf(step as f64 / 12.0 - 10.0))
             .map(|scale| counts_at(blocks, scale, n, fewest))
-            .filter_map(|counts| Some((efficiency_cost(blocks, &counts, n, samples)?, counts)))
+            .filter_map(|counts| Some((final_error(blocks, &counts, n, samples)?, counts)))
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
         (kept >= LEAST_GAIN * best).then_some(GatherSizes { columns, counts })
     }
@@ -152,29 +173,36 @@ fn counts_at(blocks: &[BlockMoments], scale: f64, n: u32, fewest: u32) -> Vec<u3
         .collect()
 }
 
-/// Variance × cost of the image with `counts` per block, after the `samples.done` samples
-/// per pixel taken with `n` candidates and for the `samples.left` still to take (all that
-/// counts where that is open-ended); `None` if nothing was measured. The film averages
-/// every sample alike, so the samples already taken weigh in with what they cost and how
-/// they vary: a few samples left cannot repay much variance added to them.
-fn efficiency_cost(
-    blocks: &[BlockMoments],
-    counts: &[u32],
-    n: u32,
-    samples: PassEnd,
-) -> Option<f64> {
-    let (done, left) = match samples.left {
-        Some(left) => (samples.done as f64, left as f64),
-        None => (0.0, 1.0),
+/// The image's error at the render's end with `counts` per block, in the time it would
+/// take with `n` everywhere, up to a factor that is the same for every choice of counts;
+/// `None` if nothing was measured. After the `samples.done` samples taken with `n`, the
+/// `samples.left` it would take with `n` become as many more as the cheaper samples buy.
+/// Where the end is not known the render is taken as endless: its variance × cost per
+/// sample, where the camera's part has vanished.
+fn final_error(blocks: &[BlockMoments], counts: &[u32], n: u32, samples: PassEnd) -> Option<f64> {
+    let kept_cost: f64 = blocks.iter().map(|b| b.cost(n as f64)).sum();
+    let cost: f64 = blocks
+        .iter()
+        .zip(counts)
+        .map(|(b, &m)| b.cost(m as f64))
+        .sum();
+    let gathers = |done: f64, left: f64| -> f64 {
+        blocks
+            .iter()
+            .zip(counts)
+            .map(|(b, &m)| done * b.gather + left * b.per_candidate(n) / m as f64)
+            .sum()
     };
-    let (mut variance, mut cost) = (0.0, 0.0);
-    for (block, &count) in blocks.iter().zip(counts) {
-        let per_candidate = block.per_candidate(n);
-        let block_cost = |m: f64| SAMPLE_COST * block.pixels + block.gathered * m;
-        variance += done * block.gather + left * per_candidate / count as f64;
-        cost += done * block_cost(n as f64) + left * block_cost(count as f64);
-    }
-    (variance > 0.0 && cost > 0.0).then_some(variance * cost)
+    let Some(left) = samples.left else {
+        let variance = gathers(0.0, 1.0);
+        return (variance > 0.0 && cost > 0.0).then_some(variance * cost);
+    };
+    let done = samples.done as f64;
+    let left = left as f64 * kept_cost / cost;
+    let total = done + left;
+    let camera: f64 = blocks.iter().map(BlockMoments::camera).sum();
+    let error = gathers(done, left) / (total * total) + camera / total.powf(1.5);
+    (error > 0.0 && total > 0.0).then_some(error)
 }
 
 /// One gather's candidates as its estimate weighs them (luminance of value / acceptance),
@@ -223,29 +251,60 @@ mod tests {
         left: None,
     };
 
-    /// A block of 256 gathering pixels whose gathers vary by `gather` per sample.
-    fn block(gather: f64) -> BlockMoments {
+    /// A block of 256 gathering pixels whose samples vary by `camera` per sample through
+    /// what the camera sees and by `gather` through their gathers.
+    fn block(camera: f64, gather: f64) -> BlockMoments {
         BlockMoments {
             pixels: 256.0,
+            total: 256.0 * (camera + gather),
             gather: 256.0 * gather,
             gathered: 256.0,
         }
     }
 
+    /// A render at 4 samples per pixel with `left` to go.
+    fn ending_after(left: u32) -> PassEnd {
+        PassEnd {
+            done: 4,
+            left: Some(left),
+        }
+    }
+
     #[test]
-    fn a_single_block_keeps_its_candidates() {
-        // (V₁ / m)(ρ₀ + m) only falls as m grows: with the camera's noise left out, fewer
-        // candidates pay only where another block needs them more.
+    fn an_endless_render_keeps_a_single_blocks_candidates() {
+        // (V₁ / m)(ρ₀ + m) only falls as m grows: where the camera's part has vanished,
+        // fewer candidates pay only where another block needs them more.
         for gather in [1e-4, 0.01, 0.05] {
             for n in [16, 128] {
-                assert_eq!(GatherSizes::choose(&[block(gather)], 1, n, OPEN), None);
+                let blocks = [block(0.05, gather)];
+                assert_eq!(GatherSizes::choose(&blocks, 1, n, OPEN), None);
             }
         }
     }
 
     #[test]
+    fn a_short_render_where_the_camera_dominates_takes_fewer_candidates() {
+        // The gathers vary by 0.002 per sample at 128 candidates, the camera's part by 0.01.
+        // At 32 samples per pixel the camera's part of the error, 0.01 / 32^1.5, is 0.9 of
+        // the gathers', 0.002 / 32: fewer candidates and more samples pay (1.56× predicted
+        // at 20). At 4004 it is 0.08 of it: they do not (1.05×, below the least gain).
+        let blocks = [block(0.01, 0.002)];
+        let short = GatherSizes::choose(&blocks, 1, 128, ending_after(28)).unwrap();
+        assert!(short.at(0, 0) <= 24, "{short:?}");
+        assert_eq!(
+            GatherSizes::choose(&blocks, 1, 128, ending_after(4000)),
+            None
+        );
+        // Without the camera's part, no render is short enough.
+        assert_eq!(
+            GatherSizes::choose(&[block(0.0, 0.002)], 1, 128, ending_after(28)),
+            None
+        );
+    }
+
+    #[test]
     fn evenly_varying_blocks_keep_their_candidates() {
-        let blocks = [block(0.01), block(0.012), block(0.009)];
+        let blocks = [block(0.0, 0.01), block(0.0, 0.012), block(0.0, 0.009)];
         assert_eq!(GatherSizes::choose(&blocks, 3, 128, OPEN), None);
     }
 
@@ -253,20 +312,22 @@ mod tests {
     fn blocks_get_counts_by_their_gathers_variance() {
         // Side by side: the first block's gathers hardly vary (a shadow), the second's do.
         // The first drops to the floor, the second keeps more.
-        let blocks = [block(0.0001), block(0.05)];
-        let sizes = GatherSizes::choose(&blocks, 2, 128, OPEN).unwrap();
-        let counts = [sizes.at(0, 0), sizes.at(TILE_SIZE, 3)];
-        assert_eq!(counts[0], 16);
-        assert!(counts[1] >= 2 * counts[0], "{counts:?}");
-        assert!((sizes.mean() - (counts[0] + counts[1]) as f64 / 2.0).abs() < 1e-9);
-        // No block's count one away does better: the scan found the optimum.
-        let best = efficiency_cost(&blocks, &counts, 128, OPEN).unwrap();
-        for block in 0..2 {
-            for step in [-1i32, 1] {
-                let mut moved = counts;
-                moved[block] = (moved[block] as i32 + step).clamp(16, 128) as u32;
-                let cost = efficiency_cost(&blocks, &moved, 128, OPEN).unwrap();
-                assert!(cost >= best * (1.0 - 1e-9), "{moved:?}");
+        let blocks = [block(0.0, 0.0001), block(0.0, 0.05)];
+        for samples in [OPEN, ending_after(100)] {
+            let sizes = GatherSizes::choose(&blocks, 2, 128, samples).unwrap();
+            let counts = [sizes.at(0, 0), sizes.at(TILE_SIZE, 3)];
+            assert_eq!(counts[0], 16);
+            assert!(counts[1] >= 2 * counts[0], "{counts:?}");
+            assert!((sizes.mean() - (counts[0] + counts[1]) as f64 / 2.0).abs() < 1e-9);
+            // No block's count one away does better: the scan found the optimum.
+            let best = final_error(&blocks, &counts, 128, samples).unwrap();
+            for block in 0..2 {
+                for step in [-1i32, 1] {
+                    let mut moved = counts;
+                    moved[block] = (moved[block] as i32 + step).clamp(16, 128) as u32;
+                    let error = final_error(&blocks, &moved, 128, samples).unwrap();
+                    assert!(error >= best * (1.0 - 1e-9), "{moved:?}");
+                }
             }
         }
     }
@@ -276,13 +337,9 @@ mod tests {
         // With 4 samples taken, the fewer are left the more of the 128 the quiet block
         // keeps: the film's plain average holds the samples taken, and variance added to a
         // few cannot be repaid.
-        let blocks = [block(0.002), block(0.05)];
+        let blocks = [block(0.0, 0.002), block(0.0, 0.05)];
         let count_with = |left| {
-            let samples = PassEnd {
-                done: 4,
-                left: Some(left),
-            };
-            GatherSizes::choose(&blocks, 2, 128, samples).map(|sizes| sizes.at(0, 0))
+            GatherSizes::choose(&blocks, 2, 128, ending_after(left)).map(|sizes| sizes.at(0, 0))
         };
         assert_eq!(count_with(1), None);
         let [four, many] = [count_with(4).unwrap(), count_with(1000).unwrap()];
@@ -309,6 +366,10 @@ mod tests {
         assert_eq!(GatherSizes::choose(&[], 0, 16, OPEN), None);
         assert_eq!(
             GatherSizes::choose(&[BlockMoments::default()], 1, 16, OPEN),
+            None
+        );
+        assert_eq!(
+            GatherSizes::choose(&[BlockMoments::default()], 1, 16, ending_after(10)),
             None
         );
     }

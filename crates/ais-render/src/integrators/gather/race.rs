@@ -279,8 +279,8 @@ impl Race {
 
     /// What the pixels measured (one arm's: AIS off's if `off_arm` is `Some(true)`, the
     /// field's if `Some(false)`; all where nothing raced), summed per 16 × 16 block of the
-    /// image (row by row): their gathers' variances, weighted as [`Race::result`] weighs
-    /// and caps the pixels', and how many of their samples gathered.
+    /// image (row by row): their weighted variances as [`Race::result`] weighs and caps
+    /// them, their gathers', and how many of their samples gathered.
     pub fn blocks(&self, off_arm: Option<bool>) -> Vec<BlockMoments> {
         let columns = GatherSizes::columns_for(self.width);
         let rows = self.height.div_ceil(TILE_SIZE);
@@ -293,8 +293,11 @@ impl Race {
             let moments = &self.pixels[pixel.y * self.width + pixel.x];
             let samples = moments.count as f64;
             let gather = pixel.weight * moments.gather_variance / samples;
-            blocks[GatherSizes::block_of(pixel.x, pixel.y, columns)]
-                .add_pixel(gather.min(cap), moments.gathers as f64 / samples);
+            blocks[GatherSizes::block_of(pixel.x, pixel.y, columns)].add_pixel(
+                pixel.variance.min(cap),
+                gather.min(cap),
+                moments.gathers as f64 / samples,
+            );
         }
         blocks
     }
