@@ -78,7 +78,8 @@ pub struct GatherFlags {
     field_race: Option<String>,
     /// map field: "false" keeps --rays candidates in every gather; "true" (the default)
     /// lets the race give fewer (down to n/8, at least 4) to 16 × 16-pixel blocks whose
-    /// gathers vary little, for more samples in the same time.
+    /// gathers vary little or whose noise is what the camera sees (most in short renders),
+    /// for more samples in the same time.
     #[arg(long)]
     field_sizes: Option<String>,
     /// Mitsuba's hide_emitters: "true" hides the emitters the camera sees directly.

@@ -405,7 +405,7 @@ fn print_field_summary(
     }
     if let Some(mean) = stats.gather_sizes {
         println!(
-            "gather sizes {mean:.1} candidates per gather on average over the image's blocks after the race (fewer where the camera's noise dominates; {} asked)",
+            "gather sizes {mean:.1} candidates per gather on average over the image's blocks after the race (fewer where gathers vary little or the camera's noise dominates; {} asked)",
             settings.rays
         );
     }

@@ -19,9 +19,10 @@
 //! most in a short render: at a few dozen samples per pixel, fewer candidates and more
 //! camera samples pay where what the camera sees dominates (foliage, edges); at a few
 //! hundred, the gathers' part is nearly all that is left. (Counting the camera's part as
-//! that of independent samples, `V_cam / N`, gave 4× in the foliage at 128 candidates and
-//! 30 samples per pixel, but lost in the sphere lights at 16 candidates and 300; leaving it
-//! out lost the foliage's gain: the repository's BENCHMARKS.md, section 5.6.)
+//! that of independent samples, `V_cam / N`, gave 4× over AIS off in the foliage at 128
+//! candidates, where a render takes a few dozen samples per pixel, but lost in the sphere
+//! lights at 16 candidates, where it takes a few hundred; leaving it out lost the foliage's
+//! gain: the repository's BENCHMARKS.md, section 5.6.)
 //!
 //! Setting each `m_b`'s derivative to zero at a fixed time gives `m_b = λ · √(V₁,b / g_b)`,
 //! one scale `λ` for the image: blocks whose gathers vary little (in shadow, or lit evenly)
