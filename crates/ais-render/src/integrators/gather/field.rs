@@ -4,10 +4,10 @@
 
 use super::batch_loop::{run_batch, BatchProbe, BatchRun, FieldUse, Lessons};
 use super::field_guide::CellGuide;
-use super::gather_sizes::GatherSizes;
+use super::gather_sizes::{least_error, GatherSizes};
 use super::guiding::CandidateSampler;
 use super::mis_share::ShareMoments;
-use super::race::{Race, RaceResult, TileMoments, RACE_PASSES};
+use super::race::{Race, RaceResult, TileMoments, RACE_MARGIN, RACE_PASSES};
 use super::strategy::{GatherPoint, Strategy};
 use super::{batch_for, note_gather_variance, GatherSettings, GatherTile, MapSource};
 use crate::geometry::Hit;
@@ -366,6 +366,37 @@ impl GatherLearning {
             .unwrap_or(UNMEASURED_COST_RATIO)
     }
 
+    /// Each race arm's predicted error at the render's end with its own gather sizes, at its
+    /// own pace (where sizes are chosen): the field's worth where it will gather with fewer
+    /// candidates. Untimed, the field's pace is AIS off's over [`RACE_MARGIN`].
+    fn arms_sized(&self, race: &RaceResult, samples: PassEnd) -> Option<[f64; 2]> {
+        if !self.chooses_sizes {
+            return None;
+        }
+        let samples = self.with_horizon(samples);
+        let field_pace = match race.seconds_per_sample {
+            Some([field, off]) => off / field,
+            None => 1.0 / RACE_MARGIN,
+        };
+        let field = least_error(
+            &self.race.blocks(Some(false)),
+            self.rays,
+            samples,
+            field_pace,
+        )?;
+        let off = least_error(&self.race.blocks(Some(true)), self.rays, samples, 1.0)?;
+        Some([field, off])
+    }
+
+    /// `samples` with what is left of the render taken from its horizon, where unknown.
+    fn with_horizon(&self, samples: PassEnd) -> PassEnd {
+        let horizon = self.horizon.map(|total| total.saturating_sub(samples.done));
+        PassEnd {
+            left: samples.left.or(horizon),
+            ..samples
+        }
+    }
+
     /// Chooses the candidates per gather per block (where `field_sizes` allows) from the
     /// pixels of the arm that won the race, or of all pixels where nothing raced.
     fn choose_sizes(&mut self, samples: PassEnd) {
@@ -374,11 +405,7 @@ impl GatherLearning {
         }
         let arm = self.race_result.map(|race| !race.field_pays());
         let blocks = self.race.blocks(arm);
-        let horizon = self.horizon.map(|total| total.saturating_sub(samples.done));
-        let samples = PassEnd {
-            left: samples.left.or(horizon),
-            ..samples
-        };
+        let samples = self.with_horizon(samples);
         let columns = GatherSizes::columns_for(self.race.width());
         self.sizes = GatherSizes::choose(&blocks, columns, self.rays, samples).map(Arc::new);
     }
@@ -424,6 +451,12 @@ impl Learning for GatherLearning {
             let guided = self.race_guided > 0;
             self.race_result = (self.races.then(|| self.race.result()).flatten())
                 .map(|race| RaceResult { guided, ..race });
+            let sized = self
+                .race_result
+                .and_then(|race| self.arms_sized(&race, samples));
+            if let Some(race) = self.race_result.as_mut() {
+                race.sized = sized;
+            }
             self.choose_sizes(samples);
             self.race = Race::default(); // its image-sized sums are no longer needed
         }

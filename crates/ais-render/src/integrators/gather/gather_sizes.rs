@@ -160,6 +160,30 @@ impl GatherSizes {
     }
 }
 
+/// The least error per pixel that counts chosen over `blocks` predict at the render's end
+/// (with `n` everywhere where no choice does better), for gathers that take `1 / pace` of
+/// the time per sample that the render's horizon was measured at: how two ways to gather,
+/// each with its own counts, compare. `None` if nothing was measured.
+pub fn least_error(blocks: &[BlockMoments], n: u32, samples: PassEnd, pace: f64) -> Option<f64> {
+    let pixels: f64 = blocks.iter().map(|b| b.pixels).sum();
+    let samples = PassEnd {
+        left: samples.left.map(|left| (left as f64 * pace).round() as u32),
+        ..samples
+    };
+    let fewest = ((n as f64 * FEWEST_SHARE).ceil() as u32).max(FEWEST).min(n);
+    let least = (0..=240)
+        .map(|step| 2f64.powf(step as f64 / 12.0 - 10.0))
+        .map(|scale| counts_at(blocks, scale, n, fewest))
+        .chain([vec![n; blocks.len()]])
+        .filter_map(|counts| final_error(blocks, &counts, n, samples))
+        .min_by(f64::total_cmp)?;
+    // Endless: variance × cost per sample, both summed over the pixels, and time per sample.
+    Some(match samples.left {
+        Some(_) => least / pixels,
+        None => least / (pixels * pixels * pace),
+    })
+}
+
 /// Each block's count at scale `λ`: `λ · √(V₁ / g)` rounded, within [`fewest`, `n`].
 fn counts_at(blocks: &[BlockMoments], scale: f64, n: u32, fewest: u32) -> Vec<u32> {
     blocks
@@ -331,6 +355,29 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn the_least_error_is_per_pixel_and_falls_with_pace() {
+        let blocks = [block(0.01, 0.002), block(0.0, 0.05)];
+        for samples in [OPEN, ending_after(28)] {
+            let at = |pace| least_error(&blocks, 128, samples, pace).unwrap();
+            assert!(at(2.0) < at(1.0), "{samples:?}");
+            // No better than the best counts' error, no worse than keeping n.
+            let kept = final_error(&blocks, &[128, 128], 128, samples).unwrap();
+            // Per pixel: the endless error is variance × cost, both summed over pixels.
+            let pixels = if samples.left.is_some() {
+                512.0
+            } else {
+                512.0 * 512.0
+            };
+            assert!(at(1.0) <= kept / pixels * (1.0 + 1e-12), "{samples:?}");
+        }
+        // Twice the pixels measuring the same: the same error per pixel.
+        let doubled = [blocks[0], blocks[0], blocks[1], blocks[1]];
+        let [one, two] = [&blocks[..], &doubled[..]]
+            .map(|b| least_error(b, 128, ending_after(28), 1.0).unwrap());
+        assert!((one - two).abs() < 1e-9 * one, "{one} {two}");
     }
 
     #[test]

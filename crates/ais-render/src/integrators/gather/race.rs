@@ -25,6 +25,16 @@
 //! the machine's drifting speed falls on both alike. Where the field loses, the rest of the render gathers as AIS
 //! off, with no field work at all. Choosing how later passes gather from what earlier
 //! passes saw keeps every pass unbiased.
+//!
+//! **Where the race also chooses gather sizes** (`field_sizes`, the default), the arms are
+//! compared as they will render: each arm's pixels choose the candidates per block they
+//! would get ([`super::gather_sizes`]), and the field is kept only if its arm predicts the
+//! lower error at the render's end, at its own pace (its measured time per sample, or
+//! AIS off's over [`RACE_MARGIN`] where untimed). A field can be worth little at `n`
+//! candidates and much at the fewer it will get: guided gathers of a few dozen candidates
+//! in a room lit through a window beat AIS off's of that size far more than at 128, and
+//! compared at `n` the field stood aside there (2.9× against AIS off at n = 128, 9.5× kept;
+//! the repository's BENCHMARKS.md, section 5.6).
 
 use super::gather_sizes::{BlockMoments, GatherSizes};
 use crate::render::{PixelRect, TILE_SIZE};
@@ -208,11 +218,16 @@ pub struct RaceResult {
     pub seconds_per_sample: Option<[f64; 2]>,
     /// Whether the field's arm guided any gather (else it only rolled).
     pub guided: bool,
+    /// The error per pixel each arm (field, AIS off) predicts at the render's end, each with
+    /// the gather sizes chosen from its own pixels, at its own pace (where sizes are chosen).
+    pub sized: Option<[f64; 2]>,
 }
 
 impl RaceResult {
-    /// Whether the field pays: its variance times its time per sample below AIS off's
-    /// where timed; else its variance times [`RACE_MARGIN`] below AIS off's.
+    /// Whether the field pays: where each arm chose its gather sizes
+    /// ([`RaceResult::sized`]), its predicted error at the render's end below AIS off's;
+    /// else its variance times its time per sample below AIS off's where timed, and its
+    /// variance times [`RACE_MARGIN`] below AIS off's where not.
     ///
     /// A field that only rolled cannot have lowered the variance of a sample (skipping
     /// candidates only adds to it): a lower variance in its arm is the race's own noise
@@ -220,6 +235,9 @@ impl RaceResult {
     /// least AIS off's, and it is kept only for time it saves. (A room lit through a door
     /// gap read 0.78–0.92 in the race, and its render ended 8% worse at equal time.)
     pub fn field_pays(&self) -> bool {
+        if let (Some([field, off]), true) = (self.sized, self.guided) {
+            return field < off;
+        }
         let field = if self.guided {
             self.field
         } else {
@@ -274,6 +292,7 @@ impl Race {
             off: off[0] / off[1],
             seconds_per_sample: self.seconds_per_sample(),
             guided: true,
+            sized: None,
         })
     }
 
@@ -441,6 +460,7 @@ mod tests {
                 off,
                 seconds_per_sample,
                 guided: true,
+                sized: None,
             }
             .field_pays()
         };
@@ -457,6 +477,7 @@ mod tests {
                 off: 1.0,
                 seconds_per_sample: Some(seconds_per_sample),
                 guided: false,
+                sized: None,
             }
             .field_pays()
         };
@@ -466,6 +487,24 @@ mod tests {
             !rolled_only(1.2, [0.9, 1.0]),
             "more variance than time saved"
         );
+    }
+
+    #[test]
+    fn a_sized_race_compares_the_arms_as_they_will_render() {
+        // The field's variance at n candidates is above AIS off's, but with the sizes each
+        // arm would get it predicts half AIS off's error: it pays.
+        let sized = |sized, guided| RaceResult {
+            field: 1.2,
+            off: 1.0,
+            seconds_per_sample: Some([1.0, 1.0]),
+            guided,
+            sized,
+        };
+        assert!(!sized(None, true).field_pays());
+        assert!(sized(Some([0.5, 1.0]), true).field_pays());
+        assert!(!sized(Some([1.5, 1.0]), true).field_pays());
+        // A field that only rolled is still judged by the time it saves.
+        assert!(!sized(Some([0.5, 1.0]), false).field_pays());
     }
 
     #[test]
