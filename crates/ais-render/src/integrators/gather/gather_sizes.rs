@@ -128,12 +128,8 @@ impl GatherSizes {
         n: u32,
         samples: PassEnd,
     ) -> Option<GatherSizes> {
-        let fewest = ((n as f64 * FEWEST_SHARE).ceil() as u32).max(FEWEST).min(n);
         let kept = final_error(blocks, &vec![n; blocks.len()], n, samples)?;
-        // λ on a log scale (steps of 2^(1/12)) wide enough for every count from 1 to n.
-        let (best, counts) = (0..=240)
-            .map(|step| 2f64.powf(step as f64 / 12.0 - 10.0))
-            .map(|scale| counts_at(blocks, scale, n, fewest))
+        let (best, counts) = scanned_counts(blocks, n)
             .filter_map(|counts| Some((final_error(blocks, &counts, n, samples)?, counts)))
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
         (kept >= LEAST_GAIN * best).then_some(GatherSizes { columns, counts })
@@ -170,10 +166,7 @@ pub fn least_error(blocks: &[BlockMoments], n: u32, samples: PassEnd, pace: f64)
         left: samples.left.map(|left| (left as f64 * pace).round() as u32),
         ..samples
     };
-    let fewest = ((n as f64 * FEWEST_SHARE).ceil() as u32).max(FEWEST).min(n);
-    let least = (0..=240)
-        .map(|step| 2f64.powf(step as f64 / 12.0 - 10.0))
-        .map(|scale| counts_at(blocks, scale, n, fewest))
+    let least = scanned_counts(blocks, n)
         .chain([vec![n; blocks.len()]])
         .filter_map(|counts| final_error(blocks, &counts, n, samples))
         .min_by(f64::total_cmp)?;
@@ -182,6 +175,15 @@ pub fn least_error(blocks: &[BlockMoments], n: u32, samples: PassEnd, pace: f64)
         Some(_) => least / pixels,
         None => least / (pixels * pixels * pace),
     })
+}
+
+/// The counts of every scale `λ` scanned: a log scale (steps of 2^(1/12)) wide enough for
+/// every count from 1 to `n`.
+fn scanned_counts(blocks: &[BlockMoments], n: u32) -> impl Iterator<Item = Vec<u32>> + '_ {
+    let fewest = ((n as f64 * FEWEST_SHARE).ceil() as u32).max(FEWEST).min(n);
+    (0..=240)
+        .map(|step| 2f64.powf(step as f64 / 12.0 - 10.0))
+        .map(move |scale| counts_at(blocks, scale, n, fewest))
 }
 
 /// Each block's count at scale `λ`: `λ · √(V₁ / g)` rounded, within [`fewest`, `n`].
