@@ -36,6 +36,9 @@ use crate::stats::Stats;
 use crate::value::Value;
 use glam::Vec3;
 
+mod plain;
+pub use plain::PlainTally;
+
 /// When the affinity map learns during a batch.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Learning {
@@ -299,6 +302,8 @@ pub struct Batch<V: Value> {
     /// Every traced ray of the current batch, recorded whatever the learning mode (see
     /// [`Batch::observe_rays`]).
     observations: Option<AffinityMap>,
+    /// The numbers of a plain batch's candidates ([`Batch::begin_plain`]).
+    plain_points: Vec<[f32; 2]>,
 }
 
 impl<V: Value> Batch<V> {
@@ -353,6 +358,7 @@ impl<V: Value> Batch<V> {
             batch_stats: Stats::default(),
             stats: Stats::default(),
             observations: None,
+            plain_points: Vec::new(),
         })
     }
 
@@ -497,11 +503,10 @@ impl<V: Value> Batch<V> {
             #[cfg(feature = "study")]
             Stopping::DropLast | Stopping::AtN => cap,
         };
-        let epoch_seed =
-            crate::rng::mix64(self.seed ^ (self.epoch as u64).wrapping_mul(0x9E37_79B9));
+        let epoch_seed = epoch_seed(self.seed, self.epoch);
         match self.config.placement {
             Placement::Halton => self.halton.rescramble(epoch_seed, self.epoch_limit),
-            Placement::Random => self.rng = Pcg32::new(epoch_seed, 0x5241_4e44), // stream "RAND"
+            Placement::Random => self.rng = random_placement(epoch_seed),
         }
     }
 
@@ -584,11 +589,7 @@ impl<V: Value> Batch<V> {
     fn place(&mut self, index: u32) -> [f32; 3] {
         match self.config.placement {
             Placement::Halton => self.halton.point(index),
-            Placement::Random => [
-                self.rng.next_f32(),
-                self.rng.next_f32(),
-                self.rng.next_f32(),
-            ],
+            Placement::Random => random_point(&mut self.rng),
         }
     }
 
@@ -772,6 +773,21 @@ impl<V: Value> Batch<V> {
             hit_cap: self.batch_stats.cap_hits > 0,
         }
     }
+}
+
+/// The scrambling seed of a batch's epoch `epoch`: each epoch's numbers are independent.
+fn epoch_seed(batch_seed: u64, epoch: usize) -> u64 {
+    crate::rng::mix64(batch_seed ^ (epoch as u64).wrapping_mul(0x9E37_79B9))
+}
+
+/// The generator of an epoch's random placement.
+fn random_placement(epoch_seed: u64) -> Pcg32 {
+    Pcg32::new(epoch_seed, 0x5241_4e44) // stream "RAND"
+}
+
+/// A candidate's three numbers under random placement.
+fn random_point(rng: &mut Pcg32) -> [f32; 3] {
+    [rng.next_f32(), rng.next_f32(), rng.next_f32()]
 }
 
 /// The rating of a traced ray: actual over unoccluded radiance (luminance), clamped to

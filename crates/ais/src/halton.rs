@@ -159,10 +159,18 @@ impl ScrambledHalton {
     /// The `index`-th point, each coordinate in [0, 1).
     #[inline]
     pub fn point(&self, index: u32) -> [f32; 3] {
+        let [u1, u2] = self.point_2d(index);
+        let u3 = (self.base5.radical_inverse(index) as f32).min(ONE_MINUS_EPSILON);
+        [u1, u2, u3]
+    }
+
+    /// The first two coordinates of the `index`-th point ([`ScrambledHalton::point`]'s),
+    /// for a host that needs no third.
+    #[inline]
+    pub fn point_2d(&self, index: u32) -> [f32; 2] {
         let u1 = (index.reverse_bits() ^ self.base2_mask) as f64 * (1.0 / 4_294_967_296.0);
         let u2 = self.base3.radical_inverse(index);
-        let u3 = self.base5.radical_inverse(index);
-        [u1, u2, u3].map(|x| (x as f32).min(ONE_MINUS_EPSILON))
+        [u1, u2].map(|x| (x as f32).min(ONE_MINUS_EPSILON))
     }
 
     /// The digit permutation applied at `position` in `base` (2, 3 or 5), for inspection.

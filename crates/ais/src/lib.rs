@@ -60,7 +60,7 @@ pub mod value;
 pub use affinity_map::{AffinityMap, LevelRule, MapConfig, MapConfigError, Mode};
 pub use batch::{
     rating, Batch, BatchConfig, BatchConfigError, Candidate, Decision, Estimate, Learning,
-    MapStart, Placement, RejectReason, Stopping,
+    MapStart, Placement, PlainTally, RejectReason, Stopping,
 };
 pub use batch_set::{BatchSet, Round};
 pub use sampling::TexelDistribution;

@@ -13,7 +13,7 @@ use crate::lights::{luminance, Draw, EnvironmentDraws, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
-use ais::{rating, Batch, BatchConfig, Decision, MapStart};
+use ais::{rating, Batch, BatchConfig, Decision, MapStart, PlainTally, Value};
 use glam::Vec3;
 use std::cell::Cell;
 use std::time::{Duration, Instant};
@@ -123,12 +123,23 @@ pub fn run_batch<P: BatchProbe>(
     // value, and nothing watches or times them one by one.
     let values_unneeded = run.field.is_some() || !run.settings.acceptance.needs_value();
     let unwatched = !P::WATCHES && run.clock.is_none();
-    if value_only && values_unneeded && unwatched && batch.decides_ahead() {
-        run_ahead(run, batch, counts, &mut lessons);
+    let ahead = value_only && values_unneeded && unwatched && batch.decides_ahead();
+    // AIS off with nothing to learn from single rays: no decision to ask the driver for.
+    let plain = ahead
+        && batch.is_plain()
+        && run.field.is_none()
+        && lessons.cell.is_none()
+        && lessons.shares.is_none();
+    let estimate = if plain {
+        run_plain(run, batch, counts, lessons.spread.as_deref_mut())
     } else {
-        run_one_by_one(run, batch, counts, probe, &mut lessons);
-    }
-    let estimate = batch.finish();
+        if ahead {
+            run_ahead(run, batch, counts, &mut lessons);
+        } else {
+            run_one_by_one(run, batch, counts, probe, &mut lessons);
+        }
+        batch.finish()
+    };
     if let Some(spread) = lessons.spread {
         spread.end_gather(estimate.candidates);
     }
@@ -152,7 +163,6 @@ fn run_ahead(
 ) {
     let mut drawn = [None; AHEAD];
     let mut weights = [1.0; AHEAD];
-    let mut blocked = [None; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
     let mut last_blocker = LastBlocker::default();
     loop {
@@ -160,21 +170,113 @@ fn run_ahead(
         if count == 0 {
             return;
         }
-        // Every slot up to `count` holds a drawn candidate.
-        for (toward, blocked) in drawn[..count].iter_mut().flatten().zip(&mut blocked) {
-            *blocked = trace_aimed(run.world, run.at, toward, counts, &mut last_blocker);
-        }
-        // The free rays' radiance looked up for all of them first: the lookups overlap.
-        let looked_up = drawn[..count].iter_mut().flatten().zip(&blocked);
-        for ((toward, blocked), arriving) in looked_up.zip(&mut arriving) {
-            *arriving = radiance_if_free(run.world, run.at, toward, *blocked);
-        }
+        let shadow_rays = ShadowRays {
+            counts,
+            last_blocker: &mut last_blocker,
+        };
+        trace_run(run, &mut drawn[..count], &mut arriving, shadow_rays);
         let traced = drawn[..count].iter_mut().flatten().zip(&arriving);
         for ((toward, &arriving), &weight) in traced.zip(&weights) {
             let traced = value_of(run, toward, arriving);
             record(run, batch, lessons, toward, &traced, weight);
         }
     }
+}
+
+/// Where a gather's shadow rays are counted, and the blocker they try first.
+struct ShadowRays<'a> {
+    counts: &'a mut RayCounts,
+    last_blocker: &'a mut LastBlocker,
+}
+
+/// Traces the shadow rays of a run of drawn candidates (`drawn`, every slot filled), then
+/// looks up what the free ones bring into `arriving` (from its start): all the lookups after
+/// all the rays, so that they overlap.
+fn trace_run(
+    run: &BatchRun,
+    drawn: &mut [Option<Toward>],
+    arriving: &mut [ShadowRay; AHEAD],
+    rays: ShadowRays,
+) {
+    let mut blocked = [None; AHEAD];
+    for (toward, blocked) in drawn.iter_mut().flatten().zip(&mut blocked) {
+        *blocked = trace_aimed(run.world, run.at, toward, rays.counts, rays.last_blocker);
+    }
+    let looked_up = drawn.iter_mut().flatten().zip(&blocked);
+    for ((toward, blocked), arriving) in looked_up.zip(arriving) {
+        *arriving = radiance_if_free(run.world, run.at, toward, *blocked);
+    }
+}
+
+/// AIS off's batch ([`Batch::is_plain`]): its numbers taken at once, its candidates drawn,
+/// traced and added up in runs of [`AHEAD`] as [`run_ahead`] does, but with no call into
+/// the driver per candidate. The same estimate and counts, to the bit. Each candidate's
+/// value goes to `spread` where given.
+fn run_plain(
+    run: &BatchRun,
+    batch: &mut Batch<[f32; 3]>,
+    counts: &mut RayCounts,
+    mut spread: Option<&mut CandidateSpread>,
+) -> ais::Estimate<[f32; 3]> {
+    let mut sum = [0.0; 3];
+    let mut tally = PlainTally::default();
+    let mut drawn = [None; AHEAD];
+    let mut arriving = [ShadowRay::Unneeded; AHEAD];
+    let mut last_blocker = LastBlocker::default();
+    for numbers in batch.begin_plain(run.rays, run.seed).chunks(AHEAD) {
+        draw_into(run, numbers, &mut drawn[..numbers.len()]);
+        let kept = keep_in_support(run.at, &mut drawn[..numbers.len()]);
+        tally.outside_support += (numbers.len() - kept) as u32;
+        tally.traced += kept as u32;
+        let shadow_rays = ShadowRays {
+            counts,
+            last_blocker: &mut last_blocker,
+        };
+        trace_run(run, &mut drawn[..kept], &mut arriving, shadow_rays);
+        for (toward, &arriving) in drawn[..kept].iter_mut().flatten().zip(&arriving) {
+            let value = value_of(run, toward, arriving).value;
+            sum = Value::add(sum, value.to_array());
+            if let Some(spread) = spread.as_deref_mut() {
+                spread.add(luminance(value) as f64);
+            }
+        }
+    }
+    batch.finish_plain(sum, tally)
+}
+
+/// Moves the candidates of `drawn` inside the support (drawn, and carried by the BSDF) to
+/// its start, in order; returns how many there are.
+fn keep_in_support(at: &GatherPoint, drawn: &mut [Option<Toward>]) -> usize {
+    let mut kept = 0;
+    for k in 0..drawn.len() {
+        if drawn[k].as_ref().is_some_and(|toward| at.carries(toward)) {
+            // (A candidate is over a hundred bytes: most stay where they were drawn.)
+            if kept != k {
+                drawn.swap(kept, k);
+            }
+            kept += 1;
+        }
+    }
+    kept
+}
+
+/// Draws the candidates of `numbers` into `slots` (as many), in order: `None` where no
+/// direction could be drawn. The environment map's draws are made all together, step by
+/// step, so that one draw's table lookups overlap the next's.
+fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>]) {
+    let mut environment = EnvironmentDraws::default();
+    for (k, (&u, slot)) in numbers.iter().zip(slots.iter_mut()).enumerate() {
+        *slot = match run.sampler.begin_direction(run.at, u) {
+            Draw::Made(toward) => toward,
+            Draw::Environment(u) => {
+                environment.push(k, u);
+                None
+            }
+        };
+    }
+    environment.draw(run.at.lights, &run.at.receiver, |k, toward| {
+        slots[k] = Some(toward)
+    });
 }
 
 /// Draws and decides candidates until [`AHEAD`] are to be traced or the batch is complete;
@@ -197,19 +299,9 @@ fn draw_ahead(
         if placed == 0 {
             break;
         }
-        // Drawn into their slots (moved only to close the gap a rejected one leaves); the
-        // environment map's draws all together, step by step.
-        let mut environment = EnvironmentDraws::default();
-        for (k, point) in (count..count + placed).zip(&points) {
-            drawn[k] = match run.sampler.begin_direction(at, [point[0], point[1]]) {
-                Draw::Made(toward) => toward,
-                Draw::Environment(u) => {
-                    environment.push(k, u);
-                    None
-                }
-            };
-        }
-        environment.draw(at.lights, &at.receiver, |k, toward| drawn[k] = Some(toward));
+        // Drawn into their slots (moved only to close the gap a rejected one leaves).
+        let numbers: [[f32; 2]; AHEAD] = std::array::from_fn(|k| [points[k][0], points[k][1]]);
+        draw_into(run, &numbers[..placed], &mut drawn[count..count + placed]);
         let mut kept = count;
         for k in count..count + placed {
             let taken = batch.next_candidate();
