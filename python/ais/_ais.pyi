@@ -133,8 +133,9 @@ def compare(
     returns ``{"configurations": [...], "tables": str, "report": str, "ray_budget": int,
     "reference_noise": float}``; each configuration is a dict with ``name``, ``label``,
     ``oracle``, ``equal_time`` (None for the oracle: spp, ms_per_spp, traced_rays_per_pixel,
-    rejected_per_pixel, ais_kib_per_thread, rel_mse {mean, error}, ratio) and
-    ``equal_rays`` (spp, seconds, rel_mse, ratio, oracle_share). The first configuration is
+    rejected_per_pixel, ais_kib_per_thread, rel_mse {mean, error}, ratio, mse {mean, error},
+    mse_ratio) and ``equal_rays`` (spp, seconds, rel_mse, ratio, oracle_share, mse,
+    mse_ratio); ``mse`` weighs every pixel alike. The first configuration is
     the baseline of the ratios. Gather parameters (``rays=…``) set the base settings.
     """
 

@@ -122,6 +122,8 @@ fn row_dict<'py>(py: Python<'py>, row: &SummaryRow) -> PyResult<Bound<'py, PyDic
             entry.set_item("ais_kib_per_thread", time.ais_kib_per_thread)?;
             entry.set_item("rel_mse", measured(py, time.rel_mse)?)?;
             entry.set_item("ratio", time.ratio)?;
+            entry.set_item("mse", measured(py, time.mse)?)?;
+            entry.set_item("mse_ratio", time.mse_ratio)?;
             Some(entry)
         }
     };
@@ -131,6 +133,8 @@ fn row_dict<'py>(py: Python<'py>, row: &SummaryRow) -> PyResult<Bound<'py, PyDic
     rays.set_item("seconds", row.equal_rays.seconds)?;
     rays.set_item("rel_mse", measured(py, row.equal_rays.rel_mse)?)?;
     rays.set_item("ratio", row.equal_rays.ratio)?;
+    rays.set_item("mse", measured(py, row.equal_rays.mse)?)?;
+    rays.set_item("mse_ratio", row.equal_rays.mse_ratio)?;
     rays.set_item("oracle_share", row.equal_rays.oracle_share)?;
     dict.set_item("equal_rays", rays)?;
     Ok(dict)

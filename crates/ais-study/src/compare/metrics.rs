@@ -5,9 +5,31 @@ use ais_render::image_io::RgbImage;
 /// The ε in relMSE's denominator: it keeps dark pixels from dominating.
 pub const RELMSE_EPSILON: f64 = 1e-2;
 
-/// Relative MSE of `image` against `reference`: the mean over pixels and channels of
-/// (image − reference)² / (reference² + ε), the same definition as `tools/crosscheck.py`.
-pub fn rel_mse(image: &RgbImage, reference: &RgbImage) -> f64 {
+/// How an error metric weighs a pixel channel's squared error, given the reference's value
+/// `r` there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelWeight {
+    /// 1 / (r² + ε): relMSE, where every pixel counts by its error relative to its
+    /// brightness (and dark pixels do not dominate).
+    Relative,
+    /// 1: the plain MSE in radiance, every pixel weighted alike (an error in a dark pixel
+    /// counts as much as one in a bright pixel, so that dark pixels are not hidden).
+    Alike,
+}
+
+impl PixelWeight {
+    /// The weight of a channel whose reference value is `r`.
+    #[inline]
+    pub fn of(self, r: f64) -> f64 {
+        match self {
+            PixelWeight::Relative => 1.0 / (r * r + RELMSE_EPSILON),
+            PixelWeight::Alike => 1.0,
+        }
+    }
+}
+
+/// The mean over pixels and channels of (image − reference)² weighed by `weight`.
+pub fn weighted_mse(image: &RgbImage, reference: &RgbImage, weight: PixelWeight) -> f64 {
     let sum: f64 = image
         .pixels
         .iter()
@@ -16,12 +38,18 @@ pub fn rel_mse(image: &RgbImage, reference: &RgbImage) -> f64 {
             (0..3)
                 .map(|c| {
                     let (a, r) = (a[c] as f64, r[c] as f64);
-                    (a - r) * (a - r) / (r * r + RELMSE_EPSILON)
+                    (a - r) * (a - r) * weight.of(r)
                 })
                 .sum::<f64>()
         })
         .sum();
     sum / (3 * image.pixels.len().max(1)) as f64
+}
+
+/// Relative MSE of `image` against `reference`: the mean over pixels and channels of
+/// (image − reference)² / (reference² + ε), the same definition as `tools/crosscheck.py`.
+pub fn rel_mse(image: &RgbImage, reference: &RgbImage) -> f64 {
+    weighted_mse(image, reference, PixelWeight::Relative)
 }
 
 /// Per-pixel relative error |image − reference| / (reference + 0.01) of the channel mean,
@@ -97,6 +125,9 @@ mod tests {
         let expected = (0.01 / 1.01 + 0.01 / 0.01) / 6.0;
         assert!((rel_mse(&noisy, &reference) - expected).abs() < 1e-6);
         assert_eq!(rel_mse(&reference, &reference), 0.0);
+        // Weighted alike, the dark pixel's error counts as much as the bright one's.
+        let alike = weighted_mse(&noisy, &reference, PixelWeight::Alike);
+        assert!((alike - (0.01 + 0.01) / 6.0).abs() < 1e-6);
     }
 
     #[test]

@@ -243,12 +243,22 @@ pub struct Run {
     pub curve: Vec<CurvePoint>,
     /// The most AIS state one thread held (bytes).
     pub ais_memory_per_thread: usize,
+    /// The final image's MSE with every pixel weighted alike, less the reference's noise.
+    pub mse: f64,
 }
 
 impl Run {
     /// The final relMSE.
     pub fn rel_mse(&self) -> f64 {
         self.curve.last().map_or(f64::NAN, |p| p.rel_mse)
+    }
+
+    /// The final error with pixels weighed by `weight`: relMSE or the MSE.
+    pub fn error(&self, weight: metrics::PixelWeight) -> f64 {
+        match weight {
+            metrics::PixelWeight::Relative => self.rel_mse(),
+            metrics::PixelWeight::Alike => self.mse,
+        }
     }
 }
 
@@ -334,6 +344,7 @@ fn progressive(
         stats: ais::Stats::default(),
         curve: Vec::new(),
         ais_memory_per_thread: 0,
+        mse: f64::NAN,
     };
     let mut learned = GatherLearning::new(world, &configuration.settings);
     let leading = configuration.leading_passes(world);
@@ -365,6 +376,7 @@ fn progressive(
             Budget::Rays(limit) => run.rays.total() >= limit,
         };
         if spent || run.spp >= MOST_PASSES {
+            run.mse = reference.error(&run.image, metrics::PixelWeight::Alike);
             return run;
         }
     }

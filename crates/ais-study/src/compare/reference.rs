@@ -1,6 +1,6 @@
 //! The converged reference of a study, cached on disk by a hash of what determines it.
 
-use super::metrics::{rel_mse, RELMSE_EPSILON};
+use super::metrics::{weighted_mse, PixelWeight};
 use ais_render::film::Film;
 use ais_render::image_io::{read_image, write_exr, RgbImage};
 use ais_render::integrators::gather::{GatherSettings, Preset, Strategy};
@@ -36,12 +36,24 @@ impl Reference {
     /// relMSE of `image` against the reference, minus the part that the reference's own
     /// noise adds on average: E[(X − R)²] = E[(X − μ)²] + Var R for an independent R.
     pub fn rel_mse(&self, image: &RgbImage) -> f64 {
-        rel_mse(image, &self.image) - self.noise_floor()
+        self.error(image, PixelWeight::Relative)
+    }
+
+    /// The error of `image` against the reference with pixels weighed by `weight`, minus the
+    /// part that the reference's own noise adds on average (as [`Reference::rel_mse`]).
+    pub fn error(&self, image: &RgbImage, weight: PixelWeight) -> f64 {
+        weighted_mse(image, &self.image, weight) - self.noise_floor_weighed(weight)
     }
 
     /// The relMSE that the reference's own noise adds on average (what
     /// [`Reference::rel_mse`] removes).
     pub fn noise_floor(&self) -> f64 {
+        self.noise_floor_weighed(PixelWeight::Relative)
+    }
+
+    /// The error with pixels weighed by `weight` that the reference's own noise adds on
+    /// average.
+    pub fn noise_floor_weighed(&self, weight: PixelWeight) -> f64 {
         let noise: f64 = self
             .image
             .pixels
@@ -49,7 +61,7 @@ impl Reference {
             .zip(&self.variance)
             .map(|(r, v)| {
                 (0..3)
-                    .map(|c| v[c] as f64 / ((r[c] as f64).powi(2) + RELMSE_EPSILON))
+                    .map(|c| v[c] as f64 * weight.of(r[c] as f64))
                     .sum::<f64>()
             })
             .sum();

@@ -113,19 +113,20 @@ fn equal_time_table(
         out,
         "Equal time ({:.1} s per run, {} seeds; ratio = baseline relMSE / relMSE, above 1 is \
          better; relMSE less the reference's own noise, {:.2e}, and scaled to the budget: \
-         relMSE × time / budget):\n",
+         relMSE × time / budget; MSE: every pixel weighted alike, corrected and scaled in the \
+         same way):\n",
         context.time_budget,
         context.seeds,
         results.reference.noise_floor()
     );
-    out.push_str("| configuration | spp | ms per spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio |\n|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| configuration | spp | ms per spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio | MSE | ratio (MSE) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
     for row in rows {
         let Some(time) = &row.equal_time else {
             continue;
         };
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {} |",
+            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {} | {} | {} |",
             row.name,
             time.spp,
             time.ms_per_spp,
@@ -134,7 +135,9 @@ fn equal_time_table(
             time.rejected_per_pixel,
             time.ais_kib_per_thread,
             with_error(time.rel_mse),
-            ratio(time.ratio)
+            ratio(time.ratio),
+            with_error(time.mse),
+            ratio(time.mse_ratio)
         );
     }
     out
@@ -146,17 +149,18 @@ fn equal_rays_table(results: &StudyResults, rows: &[SummaryRow]) -> String {
     let _ = writeln!(
         out,
         "\nEqual rays ({:.0} rays per run, the baseline's median at equal time; relMSE × rays / \
-         budget; oracle share = (baseline − relMSE) / (baseline − oracle relMSE)):\n",
+         budget; oracle share = (baseline − relMSE) / (baseline − oracle relMSE); MSE: every \
+         pixel weighted alike):\n",
         results.ray_budget as f64
     );
     out.push_str(
-        "| configuration | spp | time (s) | relMSE | ratio | oracle share |\n|---|---|---|---|---|---|\n",
+        "| configuration | spp | time (s) | relMSE | ratio | oracle share | MSE | ratio (MSE) |\n|---|---|---|---|---|---|---|---|\n",
     );
     for row in rows {
         let rays = &row.equal_rays;
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.2} | {} | {} | {} |",
+            "| {} | {:.1} | {:.2} | {} | {} | {} | {} | {} |",
             row.name,
             rays.spp,
             rays.seconds,
@@ -166,7 +170,9 @@ fn equal_rays_table(results: &StudyResults, rows: &[SummaryRow]) -> String {
                 format!("{:.0}%", 100.0 * rays.oracle_share)
             } else {
                 "–".into()
-            }
+            },
+            with_error(rays.mse),
+            ratio(rays.mse_ratio)
         );
     }
     out

@@ -1,6 +1,7 @@
 //! The study's summary numbers per configuration: what the tables show, as data (for the
 //! Markdown and HTML tables and for the Python package's dicts).
 
+use super::metrics::PixelWeight;
 use super::report::ReportContext;
 use super::{mean_and_error, Run, StudyResults};
 
@@ -32,6 +33,11 @@ pub struct EqualTime {
     pub rel_mse: Measured,
     /// The baseline's relMSE over this one (above 1 is better).
     pub ratio: f64,
+    /// The MSE with every pixel weighted alike, less the reference's noise and scaled to
+    /// the budget as relMSE is.
+    pub mse: Measured,
+    /// The baseline's MSE over this one.
+    pub mse_ratio: f64,
 }
 
 /// A configuration's equal-ray runs, averaged over seeds.
@@ -45,6 +51,10 @@ pub struct EqualRays {
     pub rel_mse: Measured,
     /// The baseline's relMSE over this one.
     pub ratio: f64,
+    /// The MSE with every pixel weighted alike, scaled to the ray budget.
+    pub mse: Measured,
+    /// The baseline's MSE over this one.
+    pub mse_ratio: f64,
     /// (baseline − relMSE) / (baseline − oracle's relMSE); NaN without an oracle.
     pub oracle_share: f64,
 }
@@ -64,11 +74,17 @@ pub struct SummaryRow {
     pub equal_rays: EqualRays,
 }
 
-/// Mean and standard error over runs of relMSE scaled to the budget: relMSE × cost /
-/// budget. A run stops after the pass that crosses its budget, so it overshoots by up to
-/// one pass; relMSE of an unbiased estimator falls as 1 / cost, so scaling removes the
-/// overshoot (it matters when a budget holds only a few passes).
-fn scaled_rel_mse(runs: &[Run], cost: impl Fn(&Run) -> f64, budget: f64) -> Measured {
+/// Mean and standard error over runs of an error (relMSE, or the MSE: `weight`) scaled to
+/// the budget: error × cost / budget. A run stops after the pass that crosses its budget,
+/// so it overshoots by up to one pass; the error of an unbiased estimator falls as 1 /
+/// cost, so scaling removes the overshoot (it matters when a budget holds only a few
+/// passes).
+fn scaled_error(
+    runs: &[Run],
+    weight: PixelWeight,
+    cost: impl Fn(&Run) -> f64,
+    budget: f64,
+) -> Measured {
     if runs.is_empty() {
         return Measured {
             mean: f64::NAN,
@@ -77,23 +93,48 @@ fn scaled_rel_mse(runs: &[Run], cost: impl Fn(&Run) -> f64, budget: f64) -> Meas
     }
     let scaled: Vec<f64> = runs
         .iter()
-        .map(|r| r.rel_mse() * cost(r) / budget)
+        .map(|r| r.error(weight) * cost(r) / budget)
         .collect();
     let (mean, error) = mean_and_error(&scaled);
     Measured { mean, error }
+}
+
+/// The two errors of a set of runs, and the baseline's over them.
+struct Errors {
+    rel_mse: Measured,
+    mse: Measured,
+}
+
+impl Errors {
+    /// The runs' errors scaled to the budget by `cost`.
+    fn of(runs: &[Run], cost: impl Fn(&Run) -> f64, budget: f64) -> Self {
+        Errors {
+            rel_mse: scaled_error(runs, PixelWeight::Relative, &cost, budget),
+            mse: scaled_error(runs, PixelWeight::Alike, &cost, budget),
+        }
+    }
+
+    /// `baseline`'s relMSE and MSE over these.
+    fn ratios(&self, baseline: &Errors) -> [f64; 2] {
+        [
+            baseline.rel_mse.mean / self.rel_mse.mean,
+            baseline.mse.mean / self.mse.mean,
+        ]
+    }
 }
 
 fn average(runs: &[Run], value: impl Fn(&Run) -> f64) -> f64 {
     runs.iter().map(value).sum::<f64>() / runs.len().max(1) as f64
 }
 
-fn equal_time(runs: &[Run], context: &ReportContext, baseline: f64) -> Option<EqualTime> {
+fn equal_time(runs: &[Run], context: &ReportContext, baseline: &Errors) -> Option<EqualTime> {
     if runs.is_empty() {
         return None;
     }
     let pixels = (context.resolution.0 * context.resolution.1) as f64;
     let spp = average(runs, |r| r.spp as f64);
-    let rel_mse = scaled_rel_mse(runs, |r| r.seconds, context.time_budget);
+    let errors = Errors::of(runs, |r| r.seconds, context.time_budget);
+    let [ratio, mse_ratio] = errors.ratios(baseline);
     Some(EqualTime {
         spp,
         ms_per_spp: 1e3 * average(runs, |r| r.seconds) / spp,
@@ -101,8 +142,10 @@ fn equal_time(runs: &[Run], context: &ReportContext, baseline: f64) -> Option<Eq
         traced_rays_per_pixel: average(runs, |r| r.rays.occlusion as f64) / pixels,
         rejected_per_pixel: average(runs, |r| r.stats.rejected_roulette as f64) / pixels,
         ais_kib_per_thread: average(runs, |r| r.ais_memory_per_thread as f64) / 1024.0,
-        ratio: baseline / rel_mse.mean,
-        rel_mse,
+        rel_mse: errors.rel_mse,
+        ratio,
+        mse: errors.mse,
+        mse_ratio,
     })
 }
 
@@ -110,35 +153,37 @@ fn equal_time(runs: &[Run], context: &ReportContext, baseline: f64) -> Option<Eq
 /// baseline of the ratios).
 pub fn summary(results: &StudyResults, context: &ReportContext) -> Vec<SummaryRow> {
     let rays_budget = results.ray_budget as f64;
-    let by_rays = |runs: &[Run]| scaled_rel_mse(runs, |r| r.rays.total() as f64, rays_budget);
-    let time_baseline = results.results.first().map_or(f64::NAN, |r| {
-        scaled_rel_mse(&r.equal_time, |r| r.seconds, context.time_budget).mean
-    });
-    let rays_baseline = results
-        .results
-        .first()
-        .map_or(f64::NAN, |r| by_rays(&r.equal_rays).mean);
+    let by_rays = |runs: &[Run]| Errors::of(runs, |r| r.rays.total() as f64, rays_budget);
+    let by_time = |runs: &[Run]| Errors::of(runs, |r| r.seconds, context.time_budget);
+    let first = results.results.first();
+    let no_runs: &[Run] = &[];
+    let time_baseline = by_time(first.map_or(no_runs, |r| &r.equal_time));
+    let rays_baseline = by_rays(first.map_or(no_runs, |r| &r.equal_rays));
     let oracle = results
         .results
         .iter()
         .find(|r| r.configuration.is_oracle())
-        .map_or(f64::NAN, |r| by_rays(&r.equal_rays).mean);
+        .map_or(f64::NAN, |r| by_rays(&r.equal_rays).rel_mse.mean);
     results
         .results
         .iter()
         .map(|result| {
-            let rel_mse = by_rays(&result.equal_rays);
+            let errors = by_rays(&result.equal_rays);
+            let [ratio, mse_ratio] = errors.ratios(&rays_baseline);
+            let baseline = rays_baseline.rel_mse.mean;
             SummaryRow {
                 name: result.configuration.name.clone(),
                 label: result.configuration.label.clone(),
                 oracle: result.configuration.is_oracle(),
-                equal_time: equal_time(&result.equal_time, context, time_baseline),
+                equal_time: equal_time(&result.equal_time, context, &time_baseline),
                 equal_rays: EqualRays {
                     spp: average(&result.equal_rays, |r| r.spp as f64),
                     seconds: average(&result.equal_rays, |r| r.seconds),
-                    ratio: rays_baseline / rel_mse.mean,
-                    oracle_share: (rays_baseline - rel_mse.mean) / (rays_baseline - oracle),
-                    rel_mse,
+                    ratio,
+                    oracle_share: (baseline - errors.rel_mse.mean) / (baseline - oracle),
+                    rel_mse: errors.rel_mse,
+                    mse: errors.mse,
+                    mse_ratio,
                 },
             }
         })
