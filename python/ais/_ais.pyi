@@ -134,8 +134,10 @@ def compare(
     "reference_noise": float}``; each configuration is a dict with ``name``, ``label``,
     ``oracle``, ``equal_time`` (None for the oracle: spp, ms_per_spp, traced_rays_per_pixel,
     rejected_per_pixel, ais_kib_per_thread, rel_mse {mean, error}, ratio, mse {mean, error},
-    mse_ratio) and ``equal_rays`` (spp, seconds, rel_mse, ratio, oracle_share, mse,
-    mse_ratio); ``mse`` weighs every pixel alike. The first configuration is
+    mse_ratio, relative_alike {mean, error}, relative_alike_ratio) and ``equal_rays`` (spp,
+    seconds, rel_mse, ratio, oracle_share, mse, mse_ratio, relative_alike,
+    relative_alike_ratio); ``mse`` weighs every pixel's error in radiance alike,
+    ``relative_alike`` every pixel's relative error (ε = 1e-4). The first configuration is
     the baseline of the ratios. Gather parameters (``rays=…``) set the base settings.
     """
 

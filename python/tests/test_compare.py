@@ -27,6 +27,7 @@ def test_compare_returns_tables_and_writes_the_report(cornell, tmp_path):
     assert baseline["equal_rays"]["ratio"] == pytest.approx(1.0)
     assert baseline["equal_time"]["mse_ratio"] == pytest.approx(1.0)
     assert baseline["equal_rays"]["mse_ratio"] == pytest.approx(1.0)
+    assert baseline["equal_time"]["relative_alike_ratio"] == pytest.approx(1.0)
     assert oracle["oracle"] and oracle["equal_time"] is None
     assert oracle["equal_rays"]["oracle_share"] == pytest.approx(1.0)
     for row in (baseline, aggressive):
@@ -35,6 +36,7 @@ def test_compare_returns_tables_and_writes_the_report(cornell, tmp_path):
         assert math.isfinite(time["rel_mse"]["error"])
         # Every pixel weighted alike, against relMSE's 1 / (r² + 0.01) ≤ 100.
         assert 0 < time["mse"]["mean"] and math.isfinite(time["mse"]["error"])
+        assert 0 < time["relative_alike"]["mean"]
         assert time["nominal_rays_per_pixel"] == pytest.approx(time["spp"] * 8)
     assert aggressive["equal_time"]["rejected_per_pixel"] > 0
     assert "| mis-aggressive |" in result["tables"]

@@ -82,6 +82,10 @@ pub struct GatherFlags {
     /// for more samples in the same time.
     #[arg(long)]
     field_sizes: Option<String>,
+    /// MIS: the BSDF's share of the candidates, in [0.05, 0.95] (the rest drawn by light
+    /// sampling), or "auto" (the default: 0.5, or what `--ais auto` learns).
+    #[arg(long)]
+    mis_share: Option<String>,
     /// Mitsuba's hide_emitters: "true" hides the emitters the camera sees directly.
     #[arg(long)]
     hide_emitters: Option<String>,
@@ -110,6 +114,7 @@ impl GatherFlags {
             "field_prior" => &self.field_prior,
             "field_race" => &self.field_race,
             "field_sizes" => &self.field_sizes,
+            "mis_share" => &self.mis_share,
             "hide_emitters" => &self.hide_emitters,
             _ => &None,
         };

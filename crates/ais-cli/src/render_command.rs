@@ -392,10 +392,12 @@ fn print_field_summary(
             stats.field_cost_ratio
         );
     }
-    if let Some(share) = stats.mis_share {
-        println!(
+    match (stats.mis_share, settings.mis_share) {
+        (Some(share), Some(_)) => println!("MIS          BSDF share {share} (given)"),
+        (Some(share), None) => println!(
             "MIS          BSDF share {share} (auto's: learned from the first passes below {LEAST_ROLLING_RAYS} candidates, {ROLLING_MIS_SHARE} from {LEAST_ROLLING_RAYS} on; AIS off uses 0.5)"
-        );
+        ),
+        (None, _) => {}
     }
     if settings.map == MapSource::Field && stats.field_stood_aside && stats.field_race.is_none() {
         println!("field        stood aside after its first passes: it found almost nothing to guide or roll, and the rest gathered as AIS off");

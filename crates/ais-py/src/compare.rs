@@ -124,6 +124,8 @@ fn row_dict<'py>(py: Python<'py>, row: &SummaryRow) -> PyResult<Bound<'py, PyDic
             entry.set_item("ratio", time.ratio)?;
             entry.set_item("mse", measured(py, time.mse)?)?;
             entry.set_item("mse_ratio", time.mse_ratio)?;
+            entry.set_item("relative_alike", measured(py, time.relative_alike)?)?;
+            entry.set_item("relative_alike_ratio", time.relative_alike_ratio)?;
             Some(entry)
         }
     };
@@ -135,6 +137,11 @@ fn row_dict<'py>(py: Python<'py>, row: &SummaryRow) -> PyResult<Bound<'py, PyDic
     rays.set_item("ratio", row.equal_rays.ratio)?;
     rays.set_item("mse", measured(py, row.equal_rays.mse)?)?;
     rays.set_item("mse_ratio", row.equal_rays.mse_ratio)?;
+    rays.set_item(
+        "relative_alike",
+        measured(py, row.equal_rays.relative_alike)?,
+    )?;
+    rays.set_item("relative_alike_ratio", row.equal_rays.relative_alike_ratio)?;
     rays.set_item("oracle_share", row.equal_rays.oracle_share)?;
     dict.set_item("equal_rays", rays)?;
     Ok(dict)

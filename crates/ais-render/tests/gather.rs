@@ -703,3 +703,23 @@ fn measure_shared_maps_in_rooms() {
         }
     }
 }
+
+#[test]
+fn a_given_mis_share_is_kept_and_unbiased() {
+    // `auto` at 16 candidates would learn its own share; a given one is kept, and AIS off
+    // takes it too.
+    let world = small_shipped_scene("sphere_lights.xml");
+    for preset in [Preset::Auto, Preset::Off] {
+        let gather = GatherSettings {
+            mis_share: Some(0.75),
+            ..settings(Strategy::Mis, preset, 16)
+        };
+        let output = render(
+            &world,
+            &Integrator::Gather(gather),
+            &small_render_settings(),
+        );
+        assert_eq!(output.stats.mis_share, Some(0.75), "{preset:?}");
+        assert_agrees_with_ais_off(&world, "sphere_lights.xml", gather);
+    }
+}

@@ -439,6 +439,35 @@ fn gather_parameters_that_cannot_apply_are_warned_of() {
     assert_eq!(field.len(), 1, "{field:?}");
     assert!(field[0].starts_with("--cost_ratio is ignored: the field rolls only"));
     assert!(warned(&[("ais", "auto"), ("rays", "64"), ("cost_ratio", "1")]).is_empty());
+    // MIS's share splits MIS's candidates only (the scene's own warning stays).
+    assert_eq!(warned(&[("mis_share", "0.25")]), scene_only);
+    let bsdf = warned(&[("strategy", "bsdf"), ("mis_share", "0.25")]);
+    assert_eq!(bsdf.len(), 2, "{bsdf:?}");
+    assert!(
+        bsdf.iter()
+            .any(|w| w.starts_with("--mis_share is ignored: it splits the candidates of MIS")),
+        "{bsdf:?}"
+    );
+}
+
+#[test]
+fn mis_share_is_a_share_or_auto() {
+    use ais_render::integrators::gather::GatherSettings;
+    let mut settings = GatherSettings::default();
+    settings.set("mis_share", "0.25").unwrap();
+    assert_eq!(settings.mis_share, Some(0.25));
+    assert!(settings.validate().is_ok());
+    settings.set("mis_share", "auto").unwrap();
+    assert_eq!(settings.mis_share, None);
+    for refused in ["0", "0.99", "nan"] {
+        settings.set("mis_share", refused).unwrap();
+        let error = settings.validate().unwrap_err();
+        assert!(
+            error.contains("mis_share must lie in [0.05, 0.95]"),
+            "{error}"
+        );
+    }
+    assert!(settings.set("mis_share", "half").is_err());
 }
 
 #[test]

@@ -86,8 +86,12 @@ impl SampleIntegrator for Oracle {
         if world.lights.is_empty() {
             return emitted.to_array();
         }
-        let at = gather_point(world, &hit, -ray.direction);
         let settings = &self.0;
+        let mut at = gather_point(world, &hit, -ray.direction);
+        // AIS off's proposal: its MIS share, where one is given.
+        if let Some(share) = settings.mis_share {
+            at.mis_bsdf_share = share as f64;
+        }
         let batch = tile.batch.get_or_insert_with(|| {
             Batch::new(BatchConfig {
                 affinity: None,

@@ -5,6 +5,11 @@ use ais_render::image_io::RgbImage;
 /// The ε in relMSE's denominator: it keeps dark pixels from dominating.
 pub const RELMSE_EPSILON: f64 = 1e-2;
 
+/// The ε of the relative error with every pixel alike ([`PixelWeight::RelativeAlike`]):
+/// small enough that a pixel of a hundredth of the image's usual brightness still counts
+/// by its relative error, and black pixels do not divide by zero.
+pub const ALIKE_EPSILON: f64 = 1e-4;
+
 /// How an error metric weighs a pixel channel's squared error, given the reference's value
 /// `r` there.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -12,8 +17,11 @@ pub enum PixelWeight {
     /// 1 / (r² + ε): relMSE, where every pixel counts by its error relative to its
     /// brightness (and dark pixels do not dominate).
     Relative,
-    /// 1: the plain MSE in radiance, every pixel weighted alike (an error in a dark pixel
-    /// counts as much as one in a bright pixel, so that dark pixels are not hidden).
+    /// 1 / (r² + 10⁻⁴): every pixel's relative error counts alike, down to pixels a
+    /// hundredth as bright as relMSE's floor lets count, so that dark pixels are not hidden.
+    RelativeAlike,
+    /// 1: the plain MSE in radiance, every pixel's absolute error alike (the bright pixels
+    /// dominate: emitters and sky seen directly).
     Alike,
 }
 
@@ -23,6 +31,7 @@ impl PixelWeight {
     pub fn of(self, r: f64) -> f64 {
         match self {
             PixelWeight::Relative => 1.0 / (r * r + RELMSE_EPSILON),
+            PixelWeight::RelativeAlike => 1.0 / (r * r + ALIKE_EPSILON),
             PixelWeight::Alike => 1.0,
         }
     }
@@ -128,6 +137,9 @@ mod tests {
         // Weighted alike, the dark pixel's error counts as much as the bright one's.
         let alike = weighted_mse(&noisy, &reference, PixelWeight::Alike);
         assert!((alike - (0.01 + 0.01) / 6.0).abs() < 1e-6);
+        // Relative and unfloored, the dark pixel's error counts a hundred times relMSE's.
+        let relative = weighted_mse(&noisy, &reference, PixelWeight::RelativeAlike);
+        assert!((relative - (0.01 / 1.0001 + 0.01 / 1e-4) / 6.0).abs() < 1e-6);
     }
 
     #[test]

@@ -243,7 +243,19 @@ pub struct Run {
     pub curve: Vec<CurvePoint>,
     /// The most AIS state one thread held (bytes).
     pub ais_memory_per_thread: usize,
-    /// The final image's MSE with every pixel weighted alike, less the reference's noise.
+    /// The final image's relative error with every pixel alike
+    /// ([`metrics::PixelWeight::RelativeAlike`]) and its MSE in radiance, less the
+    /// reference's noise.
+    pub alike: AlikeErrors,
+}
+
+/// A run's errors with every pixel weighted alike: by its relative error, and by its
+/// absolute error.
+#[derive(Clone, Copy, Debug)]
+pub struct AlikeErrors {
+    /// Relative error, ε = 10⁻⁴.
+    pub relative: f64,
+    /// Squared error in radiance.
     pub mse: f64,
 }
 
@@ -257,7 +269,8 @@ impl Run {
     pub fn error(&self, weight: metrics::PixelWeight) -> f64 {
         match weight {
             metrics::PixelWeight::Relative => self.rel_mse(),
-            metrics::PixelWeight::Alike => self.mse,
+            metrics::PixelWeight::RelativeAlike => self.alike.relative,
+            metrics::PixelWeight::Alike => self.alike.mse,
         }
     }
 }
@@ -344,7 +357,10 @@ fn progressive(
         stats: ais::Stats::default(),
         curve: Vec::new(),
         ais_memory_per_thread: 0,
-        mse: f64::NAN,
+        alike: AlikeErrors {
+            relative: f64::NAN,
+            mse: f64::NAN,
+        },
     };
     let mut learned = GatherLearning::new(world, &configuration.settings);
     let leading = configuration.leading_passes(world);
@@ -376,7 +392,10 @@ fn progressive(
             Budget::Rays(limit) => run.rays.total() >= limit,
         };
         if spent || run.spp >= MOST_PASSES {
-            run.mse = reference.error(&run.image, metrics::PixelWeight::Alike);
+            run.alike = AlikeErrors {
+                relative: reference.error(&run.image, metrics::PixelWeight::RelativeAlike),
+                mse: reference.error(&run.image, metrics::PixelWeight::Alike),
+            };
             return run;
         }
     }

@@ -113,20 +113,21 @@ fn equal_time_table(
         out,
         "Equal time ({:.1} s per run, {} seeds; ratio = baseline relMSE / relMSE, above 1 is \
          better; relMSE less the reference's own noise, {:.2e}, and scaled to the budget: \
-         relMSE × time / budget; MSE: every pixel weighted alike, corrected and scaled in the \
-         same way):\n",
+         relMSE × time / budget; alike: every pixel's relative error weighted alike, ε = 1e-4 \
+         for relMSE's 0.01, so that dark pixels are not hidden; MSE: every pixel's error in \
+         radiance alike, so the brightest dominate; both corrected and scaled as relMSE):\n",
         context.time_budget,
         context.seeds,
         results.reference.noise_floor()
     );
-    out.push_str("| configuration | spp | ms per spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio | MSE | ratio (MSE) |\n|---|---|---|---|---|---|---|---|---|---|---|\n");
+    out.push_str("| configuration | spp | ms per spp | nominal rays/pixel | traced rays/pixel | rejected/pixel | AIS KiB/thread | relMSE | ratio | MSE | ratio (MSE) | alike | ratio (alike) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for row in rows {
         let Some(time) = &row.equal_time else {
             continue;
         };
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {} | {} | {} |",
+            "| {} | {:.1} | {:.0} | {:.0} | {:.1} | {:.1} | {:.1} | {} | {} | {} | {} | {} | {} |",
             row.name,
             time.spp,
             time.ms_per_spp,
@@ -137,7 +138,9 @@ fn equal_time_table(
             with_error(time.rel_mse),
             ratio(time.ratio),
             with_error(time.mse),
-            ratio(time.mse_ratio)
+            ratio(time.mse_ratio),
+            with_error(time.relative_alike),
+            ratio(time.relative_alike_ratio)
         );
     }
     out
@@ -149,18 +152,18 @@ fn equal_rays_table(results: &StudyResults, rows: &[SummaryRow]) -> String {
     let _ = writeln!(
         out,
         "\nEqual rays ({:.0} rays per run, the baseline's median at equal time; relMSE × rays / \
-         budget; oracle share = (baseline − relMSE) / (baseline − oracle relMSE); MSE: every \
-         pixel weighted alike):\n",
+         budget; oracle share = (baseline − relMSE) / (baseline − oracle relMSE); MSE and alike \
+         as above):\n",
         results.ray_budget as f64
     );
     out.push_str(
-        "| configuration | spp | time (s) | relMSE | ratio | oracle share | MSE | ratio (MSE) |\n|---|---|---|---|---|---|---|---|\n",
+        "| configuration | spp | time (s) | relMSE | ratio | oracle share | MSE | ratio (MSE) | alike | ratio (alike) |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for row in rows {
         let rays = &row.equal_rays;
         let _ = writeln!(
             out,
-            "| {} | {:.1} | {:.2} | {} | {} | {} | {} | {} |",
+            "| {} | {:.1} | {:.2} | {} | {} | {} | {} | {} | {} | {} |",
             row.name,
             rays.spp,
             rays.seconds,
@@ -172,7 +175,9 @@ fn equal_rays_table(results: &StudyResults, rows: &[SummaryRow]) -> String {
                 "–".into()
             },
             with_error(rays.mse),
-            ratio(rays.mse_ratio)
+            ratio(rays.mse_ratio),
+            with_error(rays.relative_alike),
+            ratio(rays.relative_alike_ratio)
         );
     }
     out

@@ -38,6 +38,11 @@ pub struct EqualTime {
     pub mse: Measured,
     /// The baseline's MSE over this one.
     pub mse_ratio: f64,
+    /// The relative error with every pixel alike (ε = 10⁻⁴), corrected and scaled as
+    /// relMSE is.
+    pub relative_alike: Measured,
+    /// The baseline's relative error alike over this one.
+    pub relative_alike_ratio: f64,
 }
 
 /// A configuration's equal-ray runs, averaged over seeds.
@@ -55,6 +60,10 @@ pub struct EqualRays {
     pub mse: Measured,
     /// The baseline's MSE over this one.
     pub mse_ratio: f64,
+    /// The relative error with every pixel alike (ε = 10⁻⁴), scaled to the ray budget.
+    pub relative_alike: Measured,
+    /// The baseline's relative error alike over this one.
+    pub relative_alike_ratio: f64,
     /// (baseline − relMSE) / (baseline − oracle's relMSE); NaN without an oracle.
     pub oracle_share: f64,
 }
@@ -99,10 +108,11 @@ fn scaled_error(
     Measured { mean, error }
 }
 
-/// The two errors of a set of runs, and the baseline's over them.
+/// The errors of a set of runs: relMSE, the MSE, and the relative error alike.
 struct Errors {
     rel_mse: Measured,
     mse: Measured,
+    relative_alike: Measured,
 }
 
 impl Errors {
@@ -111,14 +121,16 @@ impl Errors {
         Errors {
             rel_mse: scaled_error(runs, PixelWeight::Relative, &cost, budget),
             mse: scaled_error(runs, PixelWeight::Alike, &cost, budget),
+            relative_alike: scaled_error(runs, PixelWeight::RelativeAlike, &cost, budget),
         }
     }
 
-    /// `baseline`'s relMSE and MSE over these.
-    fn ratios(&self, baseline: &Errors) -> [f64; 2] {
+    /// `baseline`'s relMSE, MSE and relative error alike over these.
+    fn ratios(&self, baseline: &Errors) -> [f64; 3] {
         [
             baseline.rel_mse.mean / self.rel_mse.mean,
             baseline.mse.mean / self.mse.mean,
+            baseline.relative_alike.mean / self.relative_alike.mean,
         ]
     }
 }
@@ -134,7 +146,7 @@ fn equal_time(runs: &[Run], context: &ReportContext, baseline: &Errors) -> Optio
     let pixels = (context.resolution.0 * context.resolution.1) as f64;
     let spp = average(runs, |r| r.spp as f64);
     let errors = Errors::of(runs, |r| r.seconds, context.time_budget);
-    let [ratio, mse_ratio] = errors.ratios(baseline);
+    let [ratio, mse_ratio, relative_alike_ratio] = errors.ratios(baseline);
     Some(EqualTime {
         spp,
         ms_per_spp: 1e3 * average(runs, |r| r.seconds) / spp,
@@ -146,6 +158,8 @@ fn equal_time(runs: &[Run], context: &ReportContext, baseline: &Errors) -> Optio
         ratio,
         mse: errors.mse,
         mse_ratio,
+        relative_alike: errors.relative_alike,
+        relative_alike_ratio,
     })
 }
 
@@ -169,7 +183,7 @@ pub fn summary(results: &StudyResults, context: &ReportContext) -> Vec<SummaryRo
         .iter()
         .map(|result| {
             let errors = by_rays(&result.equal_rays);
-            let [ratio, mse_ratio] = errors.ratios(&rays_baseline);
+            let [ratio, mse_ratio, relative_alike_ratio] = errors.ratios(&rays_baseline);
             let baseline = rays_baseline.rel_mse.mean;
             SummaryRow {
                 name: result.configuration.name.clone(),
@@ -184,6 +198,8 @@ pub fn summary(results: &StudyResults, context: &ReportContext) -> Vec<SummaryRo
                     rel_mse: errors.rel_mse,
                     mse: errors.mse,
                     mse_ratio,
+                    relative_alike: errors.relative_alike,
+                    relative_alike_ratio,
                 },
             }
         })

@@ -182,7 +182,8 @@ impl<P: BatchProbe> GatherTile<P> {
         // a learned share lost in the rooms, and MIS takes `ROLLING_MIS_SHARE`.
         let has_use = field && field::field_has_use(world, settings);
         let mis = has_use && settings.strategy == Strategy::Mis;
-        let learns_share = mis && !rolls;
+        // A share given in the settings is kept.
+        let learns_share = mis && !rolls && settings.mis_share.is_none();
         // Only where the field also guides light sampling, as the share was measured.
         let guided = field::field_can_guide(world, settings);
         let fixed_share = (mis && rolls && guided).then_some(mis_share::ROLLING_MIS_SHARE);
@@ -223,10 +224,12 @@ impl<P: BatchProbe> GatherTile<P> {
             race_result: learning.race_result(),
             probe,
             shares: (learns_share && tile.learns).then(ShareMoments::default),
-            mis_share: learning
-                .mis_share()
-                .filter(|_| learns_share)
-                .or(fixed_share),
+            mis_share: settings.mis_share.map(f64::from).or_else(|| {
+                learning
+                    .mis_share()
+                    .filter(|_| learns_share)
+                    .or(fixed_share)
+            }),
             settings_rays: settings.rays,
             sizes: learning.gather_sizes().cloned(),
             rays: settings.rays,

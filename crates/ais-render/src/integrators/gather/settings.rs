@@ -21,6 +21,7 @@
 //! | `field_prior` | float | 2 | `map = field`: pseudo-observations added to every cell (free) and texel (at its cell's visibility): how much evidence it takes to call a direction darker than its cell |
 //! | `field_race` | boolean | true | `map = field`: race the field against AIS off in the second and third passes and gather the rest as AIS off where it loses, or where it finds almost nothing to guide or roll; false keeps the field for the whole render (to study it) |
 //! | `field_sizes` | boolean | true | `map = field`: after the race passes (raced or not: also under area lights alone), gathers in 16 × 16-pixel blocks whose gathers vary little (in shadow, or lit evenly) get fewer candidates, down to n/8 (at least 4), so that the same time buys more samples for the pixels whose gathers vary most; false keeps `rays` everywhere |
+//! | `mis_share` | float or `auto` | `auto` | `strategy = mis`: the BSDF's share of the candidates, in [0.05, 0.95], the rest drawn by light sampling; `auto`: 0.5, except with `map = field`, which learns it from its first passes below 64 candidates and takes 0.25 from 64 on where it guides light sampling |
 //! | `hide_emitters` | boolean | false | Mitsuba's: emitters seen directly by the camera add no emission, and the environment seen directly is black |
 //! | `cost_ratio` | float or `measured` | `measured` | `map = field` with roulette (64 or more candidates): ρ, what a candidate costs besides tracing over what tracing it adds; measured on 1 gather in 16 of each pass but the last unless given (give it to make such an image reproducible bit for bit; with fewer candidates nothing is timed) |
 //!
@@ -37,7 +38,7 @@ use crate::scene::{Plugin, Property};
 use ais::{BatchConfig, MapConfig, Mode, Stopping};
 
 /// The parameter names, in the order they apply (a preset before the settings it bundles).
-pub const PARAMETERS: [&str; 20] = [
+pub const PARAMETERS: [&str; 21] = [
     "strategy",
     "rays",
     "budget",
@@ -57,6 +58,7 @@ pub const PARAMETERS: [&str; 20] = [
     "field_prior",
     "field_race",
     "field_sizes",
+    "mis_share",
     "hide_emitters",
 ];
 
@@ -286,6 +288,9 @@ pub struct GatherSettings {
     /// `map = field`: whether the race also chooses the candidates per gather per block
     /// of the image (see [`super::gather_sizes`]); false keeps `rays` everywhere.
     pub field_sizes: bool,
+    /// `strategy = mis`: the BSDF's share of the candidates; `None`: 0.5, or what the field
+    /// chooses (`map = field`).
+    pub mis_share: Option<f32>,
     /// Mitsuba's `hide_emitters`: camera rays add no emission of the emitters they hit
     /// directly, and the environment seen directly is black.
     pub hide_emitters: bool,
@@ -319,6 +324,7 @@ impl Default for GatherSettings {
             field_prior: ais::field::PRIOR_FREE,
             field_race: true,
             field_sizes: true,
+            mis_share: None,
             hide_emitters: false,
         }
     }
@@ -461,6 +467,12 @@ impl GatherSettings {
             "budget" => self.budget = Choice::parse_word(value)?,
             "placement" => self.placement = Choice::parse_word(value)?,
             "ais" => *self = self.with_preset(Choice::parse_word(value)?),
+            "mis_share" => {
+                self.mis_share = match value {
+                    "auto" => None,
+                    _ => Some(number(value, "mis_share")?),
+                }
+            }
             _ => return self.set_map_parameter(name, value),
         }
         Ok(())
@@ -591,6 +603,11 @@ impl GatherSettings {
         if !(0.0..=1e6).contains(&self.field_prior) {
             return Err("field_prior must lie in [0, 1e6]".into());
         }
+        if let Some(share) = self.mis_share {
+            if !(0.05..=0.95).contains(&share) {
+                return Err("mis_share must lie in [0.05, 0.95] (or be \"auto\")".into());
+            }
+        }
         if let Some(ratio) = self.cost_ratio {
             if !(0.0..=1e6).contains(&ratio) {
                 return Err("cost_ratio must lie in [0, 1e6] (or be \"measured\")".into());
@@ -662,6 +679,9 @@ impl GatherSettings {
             }
             "acceptance" if self.map == MapSource::None => {
                 Some("AIS off (map none) rejects no candidate")
+            }
+            "mis_share" if self.strategy != Strategy::Mis => {
+                Some("it splits the candidates of MIS only (strategy mis)")
             }
             _ => None,
         };
