@@ -265,7 +265,7 @@ impl Run {
         self.curve.last().map_or(f64::NAN, |p| p.rel_mse)
     }
 
-    /// The final error with pixels weighed by `weight`: relMSE or the MSE.
+    /// The final error with pixels weighed by `weight`: relMSE, or one of the errors alike.
     pub fn error(&self, weight: metrics::PixelWeight) -> f64 {
         match weight {
             metrics::PixelWeight::Relative => self.rel_mse(),
