@@ -379,12 +379,17 @@ impl GatherLearning {
             None => 1.0 / RACE_MARGIN,
         };
         let field = least_error(
-            &self.race.blocks(Some(false)),
+            &self.race.blocks(Some(false)).relative,
             self.rays,
             samples,
             field_pace,
         )?;
-        let off = least_error(&self.race.blocks(Some(true)), self.rays, samples, 1.0)?;
+        let off = least_error(
+            &self.race.blocks(Some(true)).relative,
+            self.rays,
+            samples,
+            1.0,
+        )?;
         Some([field, off])
     }
 

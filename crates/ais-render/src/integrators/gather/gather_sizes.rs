@@ -108,6 +108,42 @@ impl BlockMoments {
     }
 }
 
+/// What the race passes measured per block of the image, with each pixel weighed two ways:
+/// as relMSE weighs it, 1 / (r² + 0.01), and with every pixel's relative error alike down
+/// to ten times darker, 1 / (r² + 10⁻⁴).
+///
+/// relMSE's floor discounts pixels darker than about 0.1: counts that minimise it alone
+/// cut the candidates of dark blocks first, and there the image got noisier than AIS off's
+/// (sphere lights among occluders at 16 candidates: in pixels darker than 0.03, twice AIS
+/// off's error with each pixel's relative error alike; the repository's BENCHMARKS.md,
+/// section 5.6). Weighed both ways, a count is cut only where neither weighing minds.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct WeighedBlocks {
+    /// The blocks with pixels weighed as relMSE weighs them.
+    pub relative: Vec<BlockMoments>,
+    /// The blocks with every pixel's relative error alike, dark pixels included.
+    pub alike: Vec<BlockMoments>,
+}
+
+impl WeighedBlocks {
+    /// The blocks with the alike weighing's variances scaled by `alike` and added to
+    /// relMSE's: what the counts minimise. (The error at the render's end is linear in the variances, for any
+    /// counts, up to the camera's part floored at zero per block, so the blend's error is
+    /// the scaled errors' sum.)
+    fn blended(&self, alike: f64) -> Vec<BlockMoments> {
+        self.relative
+            .iter()
+            .zip(&self.alike)
+            .map(|(r, a)| BlockMoments {
+                pixels: r.pixels,
+                total: r.total + a.total * alike,
+                gather: r.gather + a.gather * alike,
+                gathered: r.gathered,
+            })
+            .collect()
+    }
+}
+
 /// The candidates per gather, per 16 × 16-pixel block of the image.
 #[derive(Clone, Debug, PartialEq)]
 pub struct GatherSizes {
@@ -122,17 +158,33 @@ impl GatherSizes {
     /// `columns` per row), the render standing at `samples` (its end as far as known);
     /// `None` where keeping `n` everywhere is as good (within [`LEAST_GAIN`]) or nothing
     /// was measured.
+    ///
+    /// The counts minimise the sum of the two weighings' errors, each relative to its error
+    /// with `n` everywhere, among those that predict neither weighing's error to grow.
     pub fn choose(
-        blocks: &[BlockMoments],
+        blocks: &WeighedBlocks,
         columns: usize,
         n: u32,
         samples: PassEnd,
     ) -> Option<GatherSizes> {
-        let kept = final_error(blocks, &vec![n; blocks.len()], n, samples)?;
-        let (best, counts) = scanned_counts(blocks, n)
-            .filter_map(|counts| Some((final_error(blocks, &counts, n, samples)?, counts)))
+        let everywhere = vec![n; blocks.relative.len()];
+        let kept = [&blocks.relative, &blocks.alike]
+            .map(|weighed| final_error(weighed, &everywhere, n, samples));
+        let [Some(relative), Some(alike)] = kept else {
+            return None;
+        };
+        // Scaled to relMSE's own size, so that the scan's scales cover its counts.
+        let blended = blocks.blended(relative / alike);
+        let no_worse = |counts: &Vec<u32>| {
+            let error = |weighed| final_error(weighed, counts, n, samples).unwrap_or(0.0);
+            error(&blocks.relative) <= relative && error(&blocks.alike) <= alike
+        };
+        let (best, counts) = scanned_counts(&blended, n)
+            .filter(no_worse)
+            .filter_map(|counts| Some((final_error(&blended, &counts, n, samples)?, counts)))
             .min_by(|a, b| a.0.total_cmp(&b.0))?;
-        (kept >= LEAST_GAIN * best).then_some(GatherSizes { columns, counts })
+        // With `n` everywhere, the blend's error is twice relMSE's.
+        (2.0 * relative >= LEAST_GAIN * best).then_some(GatherSizes { columns, counts })
     }
 
     /// Candidates for a gather in pixel (`x`, `y`).
@@ -289,6 +341,15 @@ mod tests {
         }
     }
 
+    /// `blocks` with both weighings alike: as if every pixel were brighter than relMSE's
+    /// floor.
+    fn alike(blocks: &[BlockMoments]) -> WeighedBlocks {
+        WeighedBlocks {
+            relative: blocks.to_vec(),
+            alike: blocks.to_vec(),
+        }
+    }
+
     /// A render at 4 samples per pixel with `left` to go.
     fn ending_after(left: u32) -> PassEnd {
         PassEnd {
@@ -304,7 +365,7 @@ mod tests {
         for gather in [1e-4, 0.01, 0.05] {
             for n in [16, 128] {
                 let blocks = [block(0.05, gather)];
-                assert_eq!(GatherSizes::choose(&blocks, 1, n, OPEN), None);
+                assert_eq!(GatherSizes::choose(&alike(&blocks), 1, n, OPEN), None);
             }
         }
     }
@@ -316,15 +377,15 @@ mod tests {
         // the gathers', 0.002 / 32: fewer candidates and more samples pay (1.56× predicted
         // at 20). At 4004 it is 0.08 of it: they do not (1.05×, below the least gain).
         let blocks = [block(0.01, 0.002)];
-        let short = GatherSizes::choose(&blocks, 1, 128, ending_after(28)).unwrap();
+        let short = GatherSizes::choose(&alike(&blocks), 1, 128, ending_after(28)).unwrap();
         assert!(short.at(0, 0) <= 24, "{short:?}");
         assert_eq!(
-            GatherSizes::choose(&blocks, 1, 128, ending_after(4000)),
+            GatherSizes::choose(&alike(&blocks), 1, 128, ending_after(4000)),
             None
         );
         // Without the camera's part, no render is short enough.
         assert_eq!(
-            GatherSizes::choose(&[block(0.0, 0.002)], 1, 128, ending_after(28)),
+            GatherSizes::choose(&alike(&[block(0.0, 0.002)]), 1, 128, ending_after(28)),
             None
         );
     }
@@ -332,7 +393,7 @@ mod tests {
     #[test]
     fn evenly_varying_blocks_keep_their_candidates() {
         let blocks = [block(0.0, 0.01), block(0.0, 0.012), block(0.0, 0.009)];
-        assert_eq!(GatherSizes::choose(&blocks, 3, 128, OPEN), None);
+        assert_eq!(GatherSizes::choose(&alike(&blocks), 3, 128, OPEN), None);
     }
 
     #[test]
@@ -341,7 +402,7 @@ mod tests {
         // The first drops to the floor, the second keeps more.
         let blocks = [block(0.0, 0.0001), block(0.0, 0.05)];
         for samples in [OPEN, ending_after(100)] {
-            let sizes = GatherSizes::choose(&blocks, 2, 128, samples).unwrap();
+            let sizes = GatherSizes::choose(&alike(&blocks), 2, 128, samples).unwrap();
             let counts = [sizes.at(0, 0), sizes.at(TILE_SIZE, 3)];
             assert_eq!(counts[0], 16);
             assert!(counts[1] >= 2 * counts[0], "{counts:?}");
@@ -356,6 +417,29 @@ mod tests {
                     assert!(error >= best * (1.0 - 1e-9), "{moved:?}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn a_dark_block_keeps_what_its_relative_error_needs() {
+        // relMSE's floor sees the first block's gathers hardly vary: it is dark. Weighed
+        // alike, its gathers vary as much as the bright block's, relative to their light.
+        let relative = [block(0.0, 0.0001), block(0.0, 0.05)];
+        let both = WeighedBlocks {
+            relative: relative.to_vec(),
+            alike: vec![block(0.0, 0.05), block(0.0, 0.05)],
+        };
+        for samples in [OPEN, ending_after(100)] {
+            let cut = GatherSizes::choose(&alike(&relative), 2, 128, samples).unwrap();
+            assert_eq!(
+                cut.at(0, 0),
+                16,
+                "relMSE alone cuts the dark block to the floor"
+            );
+            let kept = GatherSizes::choose(&both, 2, 128, samples);
+            // Either no count changes or the dark block keeps more: never the cut above.
+            let dark = kept.map_or(128, |sizes| sizes.at(0, 0));
+            assert!(dark > 2 * cut.at(0, 0), "{samples:?}: {dark}");
         }
     }
 
@@ -389,7 +473,8 @@ mod tests {
         // few cannot be repaid.
         let blocks = [block(0.0, 0.002), block(0.0, 0.05)];
         let count_with = |left| {
-            GatherSizes::choose(&blocks, 2, 128, ending_after(left)).map(|sizes| sizes.at(0, 0))
+            GatherSizes::choose(&alike(&blocks), 2, 128, ending_after(left))
+                .map(|sizes| sizes.at(0, 0))
         };
         assert_eq!(count_with(1), None);
         let [four, many] = [count_with(4).unwrap(), count_with(1000).unwrap()];
@@ -413,13 +498,13 @@ mod tests {
 
     #[test]
     fn nothing_measured_changes_nothing() {
-        assert_eq!(GatherSizes::choose(&[], 0, 16, OPEN), None);
+        assert_eq!(GatherSizes::choose(&alike(&[]), 0, 16, OPEN), None);
         assert_eq!(
-            GatherSizes::choose(&[BlockMoments::default()], 1, 16, OPEN),
+            GatherSizes::choose(&alike(&[BlockMoments::default()]), 1, 16, OPEN),
             None
         );
         assert_eq!(
-            GatherSizes::choose(&[BlockMoments::default()], 1, 16, ending_after(10)),
+            GatherSizes::choose(&alike(&[BlockMoments::default()]), 1, 16, ending_after(10)),
             None
         );
     }

@@ -36,7 +36,7 @@
 //! compared at `n` the field stood aside there (2.9× against AIS off at n = 128, 9.5× kept;
 //! the repository's BENCHMARKS.md, section 5.6).
 
-use super::gather_sizes::{BlockMoments, GatherSizes};
+use super::gather_sizes::{BlockMoments, GatherSizes, WeighedBlocks};
 use crate::render::{PixelRect, TILE_SIZE};
 use crate::texture::luminance;
 use glam::Vec3;
@@ -55,6 +55,15 @@ pub const RACE_PASSES: std::ops::RangeInclusive<u32> = 1..=2;
 /// (race ratio against final relMSE ratio: sunlit room 0.46 / 0.39, interior 0.90 /
 /// 0.75, courtyard 0.67 / 0.68).
 pub const RACE_MARGIN: f64 = 1.1;
+
+/// The floor under a pixel's squared brightness in relMSE's weight, 1 / (r² + 0.01): the
+/// race's verdict and the gather sizes weigh pixels so.
+pub const RELATIVE_FLOOR: f64 = 0.01;
+
+/// The floor under a pixel's squared brightness where every pixel's relative error counts
+/// alike, down to pixels a tenth as bright as relMSE's floor lets count: the gather sizes
+/// weigh pixels so too, so that the counts that lower relMSE do not starve dark blocks.
+pub const ALIKE_FLOOR: f64 = 1e-4;
 
 /// Pixels' weighted variances are capped at this quantile of both arms' before the arms
 /// are averaged. Three samples per pixel make the plain mean hostage to a few fireflies:
@@ -192,7 +201,7 @@ struct WeightedPixel {
     y: usize,
     /// Whether it raced as AIS off.
     races_off: bool,
-    /// 1 / (r² + 0.01), with r the mean of the pixels around.
+    /// 1 / (r² + floor), with r the mean of the pixels around.
     weight: f64,
     /// Its per-sample variance times `weight`.
     variance: f64,
@@ -279,7 +288,7 @@ impl Race {
     /// pixels with two samples or more. The field's arm is taken to have guided
     /// ([`RaceResult::guided`]): a host whose field only rolled says so.
     pub fn result(&self) -> Option<RaceResult> {
-        let (pixels, cap) = self.weighted_pixels();
+        let (pixels, cap) = self.weighted_pixels(RELATIVE_FLOOR);
         let mut sums = [[0.0f64; 2]; 2]; // [field, off] × [capped variance, pixels]
         for pixel in pixels {
             let arm = &mut sums[usize::from(pixel.races_off)];
@@ -298,13 +307,22 @@ impl Race {
 
     /// What the pixels measured (one arm's: AIS off's if `off_arm` is `Some(true)`, the
     /// field's if `Some(false)`; all where nothing raced), summed per 16 × 16 block of the
-    /// image (row by row): their weighted variances as [`Race::result`] weighs and caps
-    /// them, their gathers', and how many of their samples gathered.
-    pub fn blocks(&self, off_arm: Option<bool>) -> Vec<BlockMoments> {
+    /// image (row by row), weighed both ways ([`WeighedBlocks`]): their weighted variances
+    /// as [`Race::result`] weighs and caps them, their gathers', and how many of their
+    /// samples gathered.
+    pub fn blocks(&self, off_arm: Option<bool>) -> WeighedBlocks {
+        WeighedBlocks {
+            relative: self.blocks_weighed(off_arm, RELATIVE_FLOOR),
+            alike: self.blocks_weighed(off_arm, ALIKE_FLOOR),
+        }
+    }
+
+    /// [`Race::blocks`] with each pixel weighed by 1 / (r² + `floor`).
+    fn blocks_weighed(&self, off_arm: Option<bool>, floor: f64) -> Vec<BlockMoments> {
         let columns = GatherSizes::columns_for(self.width);
         let rows = self.height.div_ceil(TILE_SIZE);
         let mut blocks = vec![BlockMoments::default(); columns * rows];
-        let (pixels, cap) = self.weighted_pixels();
+        let (pixels, cap) = self.weighted_pixels(floor);
         for pixel in pixels
             .iter()
             .filter(|p| off_arm.is_none_or(|off| p.races_off == off))
@@ -321,15 +339,16 @@ impl Race {
         blocks
     }
 
-    /// Every pixel with two samples or more, its variance weighted as relMSE weighs it,
-    /// and the cap on those variances (their [`CAP_QUANTILE`]).
-    fn weighted_pixels(&self) -> (Vec<WeightedPixel>, f64) {
+    /// Every pixel with two samples or more, its variance weighted by 1 / (r² + `floor`)
+    /// (r the mean of the pixels around), and the cap on those variances (their
+    /// [`CAP_QUANTILE`]).
+    fn weighted_pixels(&self, floor: f64) -> (Vec<WeightedPixel>, f64) {
         let mut weighted = Vec::new();
         for y in 0..self.height.min(self.pixels.len() / self.width.max(1)) {
             for x in 0..self.width {
                 if let Some(variance) = self.pixels[y * self.width + x].variance() {
                     let reference = self.neighbourhood_mean(x, y);
-                    let weight = 1.0 / (reference * reference + 0.01);
+                    let weight = 1.0 / (reference * reference + floor);
                     weighted.push(WeightedPixel {
                         x,
                         y,
