@@ -37,6 +37,10 @@
 //! every sample alike, so the samples taken with `n` candidates before the choice stay in
 //! the image with their variance.
 //!
+//! Each pixel's variances are weighed two ways ([`WeighedBlocks`]): as relMSE weighs them
+//! and with dark pixels' relative error counted alike. The counts minimise both errors
+//! together, and none may be predicted to grow.
+//!
 //! `V₁` comes from the gathers' own estimate of their variance, which counts the candidates
 //! as independent: Halton's stratified candidates vary less, so the estimate is high where
 //! they stratify well, and `V_cam` (the pixels' sample variance less that estimate) low.
@@ -69,7 +73,7 @@ pub const FEWEST: u32 = 4;
 pub const LEAST_GAIN: f64 = 1.1;
 
 /// What the race passes measured in one block of the image, summed over its pixels (each
-/// pixel's variances weighted as relMSE weighs them).
+/// pixel's variances weighted as one of [`WeighedBlocks`]'s weighings weighs them).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct BlockMoments {
     /// Pixels measured.
