@@ -131,9 +131,9 @@ pub struct WeighedBlocks {
 
 impl WeighedBlocks {
     /// The blocks with the alike weighing's variances scaled by `alike` and added to
-    /// relMSE's: what the counts minimise. (The error at the render's end is linear in the variances, for any
-    /// counts, up to the camera's part floored at zero per block, so the blend's error is
-    /// the scaled errors' sum.)
+    /// relMSE's: what the counts minimise. (The error at the render's end is linear in the
+    /// variances, for any counts, up to the camera's part floored at zero per block, so the
+    /// blend's error is the scaled errors' sum.)
     fn blended(&self, alike: f64) -> Vec<BlockMoments> {
         self.relative
             .iter()
