@@ -379,13 +379,13 @@ impl GatherLearning {
             None => 1.0 / RACE_MARGIN,
         };
         let field = least_error(
-            &self.race.blocks(Some(false)).relative,
+            &self.race.relative_blocks(Some(false)),
             self.rays,
             samples,
             field_pace,
         )?;
         let off = least_error(
-            &self.race.blocks(Some(true)).relative,
+            &self.race.relative_blocks(Some(true)),
             self.rays,
             samples,
             1.0,

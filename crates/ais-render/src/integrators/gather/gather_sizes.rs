@@ -120,7 +120,8 @@ impl BlockMoments {
 /// cut the candidates of dark blocks first, and there the image got noisier than AIS off's
 /// (sphere lights among occluders at 16 candidates: in pixels darker than 0.03, twice AIS
 /// off's error with each pixel's relative error alike; the repository's BENCHMARKS.md,
-/// section 5.6). Weighed both ways, a count is cut only where neither weighing minds.
+/// section 5.6). Weighed both ways, the counts change only where neither image error is
+/// predicted to grow.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct WeighedBlocks {
     /// The blocks with pixels weighed as relMSE weighs them.

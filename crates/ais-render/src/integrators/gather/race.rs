@@ -317,6 +317,11 @@ impl Race {
         }
     }
 
+    /// [`Race::blocks`] weighed as relMSE weighs pixels only: how the race's arms compare.
+    pub fn relative_blocks(&self, off_arm: Option<bool>) -> Vec<BlockMoments> {
+        self.blocks_weighed(off_arm, RELATIVE_FLOOR)
+    }
+
     /// [`Race::blocks`] with each pixel weighed by 1 / (r² + `floor`).
     fn blocks_weighed(&self, off_arm: Option<bool>, floor: f64) -> Vec<BlockMoments> {
         let columns = GatherSizes::columns_for(self.width);
