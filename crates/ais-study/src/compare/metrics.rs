@@ -2,13 +2,15 @@
 
 use ais_render::image_io::RgbImage;
 
-/// The ε in relMSE's denominator: it keeps dark pixels from dominating.
-pub const RELMSE_EPSILON: f64 = 1e-2;
+/// The ε in relMSE's denominator, 0.01: it keeps dark pixels from dominating. (The
+/// renderer's race and gather sizes weigh pixels by the same floor.)
+pub const RELMSE_EPSILON: f64 = ais_render::integrators::gather::race::RELATIVE_FLOOR;
 
-/// The ε of the relative error with every pixel alike ([`PixelWeight::RelativeAlike`]):
-/// small enough that a pixel of a hundredth of the image's usual brightness still counts
-/// by its relative error, and black pixels do not divide by zero.
-pub const ALIKE_EPSILON: f64 = 1e-4;
+/// The ε of the relative error with every pixel alike ([`PixelWeight::RelativeAlike`]),
+/// 10⁻⁴: small enough that a pixel a tenth as bright as relMSE's floor lets count still
+/// counts by its relative error, and black pixels do not divide by zero. (The gather sizes
+/// weigh pixels by it too.)
+pub const ALIKE_EPSILON: f64 = ais_render::integrators::gather::race::ALIKE_FLOOR;
 
 /// How an error metric weighs a pixel channel's squared error, given the reference's value
 /// `r` there.
@@ -18,7 +20,7 @@ pub enum PixelWeight {
     /// brightness (and dark pixels do not dominate).
     Relative,
     /// 1 / (r² + 10⁻⁴): every pixel's relative error counts alike, down to pixels a
-    /// hundredth as bright as relMSE's floor lets count, so that dark pixels are not hidden.
+    /// tenth as bright as relMSE's floor lets count, so that dark pixels are not hidden.
     RelativeAlike,
     /// 1: the plain MSE in radiance, every pixel's absolute error alike (the bright pixels
     /// dominate: emitters and sky seen directly).

@@ -84,11 +84,10 @@ pub struct SummaryRow {
 }
 
 /// Mean and standard error over runs of an error (relMSE, or one with every pixel alike:
-/// `weight`) scaled to
-/// the budget: error × cost / budget. A run stops after the pass that crosses its budget,
-/// so it overshoots by up to one pass; the error of an unbiased estimator falls as 1 /
-/// cost, so scaling removes the overshoot (it matters when a budget holds only a few
-/// passes).
+/// `weight`) scaled to the budget: error × cost / budget. A run stops after the pass that
+/// crosses its budget, so it overshoots by up to one pass; the error of an unbiased
+/// estimator falls as 1 / cost, so scaling removes the overshoot (it matters when a budget
+/// holds only a few passes).
 fn scaled_error(
     runs: &[Run],
     weight: PixelWeight,

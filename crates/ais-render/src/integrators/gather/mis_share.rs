@@ -27,6 +27,7 @@
 //! tile order per cell and over the cells in their keys' order, so the choice does not
 //! depend on the thread count.
 
+use super::race::RELATIVE_FLOOR;
 use super::strategy::MisParts;
 use ais::field::CellKey;
 use std::collections::HashMap;
@@ -141,9 +142,6 @@ impl ShareMoments {
         least.map(|k| MIS_SHARES[k])
     }
 }
-
-/// The floor under a cell's squared mean in its weight, relMSE's 0.01.
-const RELATIVE_FLOOR: f64 = 0.01;
 
 #[cfg(test)]
 mod tests {
