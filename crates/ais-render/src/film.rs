@@ -44,19 +44,32 @@ impl ReconstructionFilter {
 
     /// The weight along one axis at distance `x` (pixels) from the sample.
     pub fn eval(&self, x: f32) -> f32 {
+        let mut weight = [x];
+        self.eval_in_place(&mut weight);
+        weight[0]
+    }
+
+    /// Replaces each distance of `xs` by its weight along one axis: a Gaussian's constant
+    /// term is worked out once for all of them (the same values as [`Self::eval`]).
+    fn eval_in_place(&self, xs: &mut [f32]) {
         match *self {
             ReconstructionFilter::Box => {
-                if x.abs() <= 0.5 {
-                    1.0
-                } else {
-                    0.0
+                for x in xs {
+                    *x = if x.abs() <= 0.5 { 1.0 } else { 0.0 };
                 }
             }
-            ReconstructionFilter::Tent { radius } => (1.0 - x.abs() / radius).max(0.0),
+            ReconstructionFilter::Tent { radius } => {
+                for x in xs {
+                    *x = (1.0 - x.abs() / radius).max(0.0);
+                }
+            }
             ReconstructionFilter::Gaussian { stddev } => {
                 let alpha = -1.0 / (2.0 * stddev * stddev);
                 let radius = 4.0 * stddev;
-                ((alpha * x * x).exp() - (alpha * radius * radius).exp()).max(0.0)
+                let at_radius = (alpha * radius * radius).exp();
+                for x in xs {
+                    *x = ((alpha * *x * *x).exp() - at_radius).max(0.0);
+                }
             }
         }
     }
@@ -190,8 +203,9 @@ impl AxisWeights {
         let count = (last + 1 - first as i64).clamp(0, MOST_REACHED as i64) as usize;
         let mut weights = [0.0; MOST_REACHED];
         for (i, weight) in weights.iter_mut().take(count).enumerate() {
-            *weight = filter.eval((first + i) as f32 + 0.5 - p);
+            *weight = (first + i) as f32 + 0.5 - p;
         }
+        filter.eval_in_place(&mut weights[..count]);
         AxisWeights {
             first,
             weights,

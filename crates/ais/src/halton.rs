@@ -144,16 +144,24 @@ impl ScrambledHalton {
     /// which is what makes a scramble cheap for a small batch; points beyond `count` keep
     /// their stratification but are not independently scrambled.
     pub fn rescramble(&mut self, seed: u64, count: u32) {
+        let mut rng = self.rescramble_2d(seed, count);
+        self.base5.randomize(
+            &mut rng,
+            DigitScramble::<5, DIGITS_BASE5>::digits_for(count),
+        );
+    }
+
+    /// [`ScrambledHalton::rescramble`] for the first two coordinates alone
+    /// ([`ScrambledHalton::point_2d`]; the same ones, drawn first), leaving the third's
+    /// permutations as they were. Returns the generator, to draw the third's from.
+    pub fn rescramble_2d(&mut self, seed: u64, count: u32) -> Pcg32 {
         let mut rng = Pcg32::new(seed, 0x4841_4c54_4f4e); // stream "HALTON"
         self.base2_mask = rng.next_u32();
         self.base3.randomize(
             &mut rng,
             DigitScramble::<3, DIGITS_BASE3>::digits_for(count),
         );
-        self.base5.randomize(
-            &mut rng,
-            DigitScramble::<5, DIGITS_BASE5>::digits_for(count),
-        );
+        rng
     }
 
     /// The `index`-th point, each coordinate in [0, 1).

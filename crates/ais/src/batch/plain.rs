@@ -67,7 +67,9 @@ impl<V: Value> Batch<V> {
         self.plain_points.clear();
         match self.config.placement {
             Placement::Halton => {
-                self.halton.rescramble(epoch_seed, n);
+                // Two coordinates each: the third's permutations are not drawn (the
+                // next batch that reads them scrambles them afresh).
+                self.halton.rescramble_2d(epoch_seed, n);
                 let points = (0..n).map(|index| self.halton.point_2d(index));
                 self.plain_points.extend(points);
             }

@@ -189,9 +189,9 @@ struct ShadowRays<'a> {
     last_blocker: &'a mut LastBlocker,
 }
 
-/// Traces the shadow rays of a run of drawn candidates (`drawn`, every slot filled), then
-/// looks up what the free ones bring into `arriving` (from its start): all the lookups after
-/// all the rays, so that they overlap.
+/// Traces the shadow rays of a run of drawn candidates (`drawn`; empty slots are passed
+/// over), then looks up what the free ones bring into `arriving` (from its start, in the
+/// order of the filled slots): all the lookups after all the rays, so that they overlap.
 fn trace_run(
     run: &BatchRun,
     drawn: &mut [Option<Toward>],
@@ -224,16 +224,17 @@ fn run_plain(
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
     let mut last_blocker = LastBlocker::default();
     for numbers in batch.begin_plain(run.rays, run.seed).chunks(AHEAD) {
-        draw_into(run, numbers, &mut drawn[..numbers.len()]);
-        let kept = keep_in_support(run.at, &mut drawn[..numbers.len()]);
+        let drawn = &mut drawn[..numbers.len()];
+        draw_into(run, numbers, drawn);
+        let kept = keep_in_support(run.at, drawn);
         tally.outside_support += (numbers.len() - kept) as u32;
         tally.traced += kept as u32;
         let shadow_rays = ShadowRays {
             counts,
             last_blocker: &mut last_blocker,
         };
-        trace_run(run, &mut drawn[..kept], &mut arriving, shadow_rays);
-        for (toward, &arriving) in drawn[..kept].iter_mut().flatten().zip(&arriving) {
+        trace_run(run, drawn, &mut arriving, shadow_rays);
+        for (toward, &arriving) in drawn.iter_mut().flatten().zip(&arriving) {
             let value = value_of(run, toward, arriving).value;
             sum = Value::add(sum, value.to_array());
             if let Some(spread) = spread.as_deref_mut() {
@@ -244,17 +245,16 @@ fn run_plain(
     batch.finish_plain(sum, tally)
 }
 
-/// Moves the candidates of `drawn` inside the support (drawn, and carried by the BSDF) to
-/// its start, in order; returns how many there are.
+/// Empties the slots of `drawn` whose candidates lie outside the support (not carried by
+/// the BSDF), leaving the others where they are (a candidate is over a hundred bytes);
+/// returns how many are left.
 fn keep_in_support(at: &GatherPoint, drawn: &mut [Option<Toward>]) -> usize {
     let mut kept = 0;
-    for k in 0..drawn.len() {
-        if drawn[k].as_ref().is_some_and(|toward| at.carries(toward)) {
-            // (A candidate is over a hundred bytes: most stay where they were drawn.)
-            if kept != k {
-                drawn.swap(kept, k);
-            }
+    for slot in drawn {
+        if slot.as_ref().is_some_and(|toward| at.carries(toward)) {
             kept += 1;
+        } else {
+            *slot = None;
         }
     }
     kept
