@@ -24,7 +24,7 @@ use super::ONE_BELOW;
 use crate::image_io::RgbImage;
 use ais::fast_trig;
 use ais::sampling::{uniform_sphere, CdfGrid};
-use glam::{DMat3, Mat3, Vec3};
+use glam::{DMat3, Mat3, Vec3, Vec4};
 use std::f32::consts::PI as PI32;
 use std::f64::consts::PI;
 
@@ -45,7 +45,12 @@ pub enum Environment {
 /// A lat-long environment image with its sampling tables.
 #[derive(Clone, Debug)]
 pub struct EnvironmentMap {
-    image: RgbImage,
+    /// The image's size in texels.
+    width: usize,
+    height: usize,
+    /// The image's texels (row-major) with a fourth lane, aligned: a texel is one 16-byte
+    /// load, and the bilinear lookup's lerps run on all channels at once.
+    texels: Vec<Vec4>,
     to_world: Mat3,
     to_local: Mat3,
     /// The `width × (height − 1)` cells by probability (row-major). Cell (c, r) has texel
@@ -102,7 +107,13 @@ impl EnvironmentMap {
             cell_density,
             to_local: to_world.inverse().as_mat3(),
             to_world: to_world.as_mat3(),
-            image,
+            width,
+            height,
+            texels: image
+                .pixels
+                .iter()
+                .map(|&[r, g, b]| Vec4::new(r, g, b, 0.0))
+                .collect(),
             row_cosines: row_cosines.iter().map(|&c| c as f32).collect(),
             mean_luminance: total / (4.0 * PI),
             partitions: Default::default(),
@@ -120,7 +131,7 @@ impl EnvironmentMap {
         }
         let u = u.min(ONE_BELOW);
         let v = fast_trig::acos(d.y) * (1.0 / PI32);
-        let (width, rows) = (self.image.width, self.row_cosines.len() - 1);
+        let (width, rows) = (self.width, self.row_cosines.len() - 1);
         // Cells start half a texel after u = 0 (their corners are texel centres).
         let mut x = u * width as f32 - 0.5;
         if x < 0.0 {
@@ -138,7 +149,7 @@ impl EnvironmentMap {
     /// Bilinear interpolation at Mitsuba's (u, v), in its texel layout.
     #[inline]
     fn interpolate(&self, location: MapLocation) -> Vec3 {
-        let (width, height) = (self.image.width, self.image.height);
+        let (width, height) = (self.width, self.height);
         let x = location.u * width as f32 - 0.5;
         let x0 = x.floor();
         let fx = x - x0;
@@ -153,10 +164,10 @@ impl EnvironmentMap {
         let y = v.clamp(0.0, 1.0) * (height - 1) as f32;
         let r0 = (y as usize).min(height - 2);
         let fy = y - r0 as f32;
-        let texel = |c: usize, r: usize| Vec3::from(self.image.pixels[r * width + c]);
+        let texel = |c: usize, r: usize| self.texels[r * width + c];
         let top = texel(c0, r0).lerp(texel(c1, r0), fx);
         let bottom = texel(c0, r0 + 1).lerp(texel(c1, r0 + 1), fx);
-        top.lerp(bottom, fy)
+        top.lerp(bottom, fy).truncate()
     }
 
     /// A direction drawn from `u`, located: a row of cells, a cell in it, then a point
@@ -245,7 +256,7 @@ impl EnvironmentMap {
     /// The row and column of `cell` (row-major).
     #[inline]
     pub(super) fn row_column(&self, cell: usize) -> (usize, usize) {
-        (cell / self.image.width, cell % self.image.width)
+        (cell / self.width, cell % self.width)
     }
 
     /// [`EnvironmentMap::toward_in_cell`] for the cell at `row` and `column`.
@@ -256,7 +267,7 @@ impl EnvironmentMap {
         column: usize,
         [fx, fy]: [f32; 2],
     ) -> Toward {
-        let width = self.image.width;
+        let width = self.width;
         let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
         let cos_theta = (top + fy * (bottom - top)).clamp(-1.0, 1.0);
         let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
