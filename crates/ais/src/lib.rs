@@ -20,7 +20,8 @@
 //! - [`field`]: a learned visibility field over the whole image, fixed during a pass, and
 //!   the acceptance it gives each candidate;
 //! - [`mapping`]: lat-long direction ↔ texel;
-//! - [`fast_trig`]: f32 atan2 and acos within 4e-7 rad, for per-candidate lookups;
+//! - [`fast_trig`]: f32 atan2 and acos within 4e-7 rad, sin and cos within 2e-7, for
+//!   per-candidate lookups and draws;
 //! - [`sampling`]: warps and piecewise-constant distributions (sample, pdf, invert), including
 //!   a density over a map's texels to fold a fixed map into a proposal;
 //! - [`stats`]: counters; [`value`]: what a batch can average; [`rng`]: a seedable PCG32 and

@@ -228,7 +228,7 @@ impl AreaLight {
                 // resolution at 1); the azimuth needs no more than f32.
                 let cos_theta = 1.0 - u[0] as f64 * (1.0 - cone.cos_max);
                 let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt() as f32;
-                let (sin_phi, cos_phi) = (std::f32::consts::TAU * u[1]).sin_cos();
+                let (sin_phi, cos_phi) = ais::fast_trig::sin_cos(std::f32::consts::TAU * u[1]);
                 let (t, b) = crate::geometry::basis(cone.axis);
                 let direction = (t * (sin_theta * cos_phi)
                     + b * (sin_theta * sin_phi)

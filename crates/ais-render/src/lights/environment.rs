@@ -65,6 +65,18 @@ pub struct EnvironmentMap {
     partitions: super::environment_guide::PartitionCache,
 }
 
+/// How many cell points [`EnvironmentMap::towards_at`] works out at once.
+const LANES: usize = 16;
+
+/// A point of an environment map's cell: its row and column, and the fractions of its
+/// azimuth and cos θ range.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct CellPoint {
+    pub row: usize,
+    pub column: usize,
+    pub within: [f32; 2],
+}
+
 /// Where a direction falls on an environment map: Mitsuba's u, cos θ (v = acos(cos θ) / π,
 /// worked out only when the radiance is looked up) and the sampling cell.
 #[derive(Clone, Copy, Debug)]
@@ -265,25 +277,60 @@ impl EnvironmentMap {
         &self,
         row: usize,
         column: usize,
-        [fx, fy]: [f32; 2],
+        within: [f32; 2],
     ) -> Toward {
-        let width = self.width;
-        let (top, bottom) = (self.row_cosines[row], self.row_cosines[row + 1]);
-        let cos_theta = (top + fy * (bottom - top)).clamp(-1.0, 1.0);
-        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-        let mut u = (column as f32 + 0.5 + fx) / width as f32;
-        if u >= 1.0 {
-            u -= 1.0;
-        }
-        let u = u.min(ONE_BELOW);
-        let (sin_phi, cos_phi) = (2.0 * PI32 * u).sin_cos();
-        let local = Vec3::new(sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta);
-        let location = MapLocation {
-            u,
-            cos_theta,
-            cell: row * width + column,
+        let mut toward = None;
+        let cell = CellPoint {
+            row,
+            column,
+            within,
         };
-        Toward::from_environment((self.to_world * local).normalize(), Some(location))
+        self.towards_at(&[cell], |_, drawn| toward = Some(drawn));
+        toward.expect("a direction for every cell point")
+    }
+
+    /// [`EnvironmentMap::toward_in_row_column`] for each of `points`, given to `put` with
+    /// its index: worked out in runs of [`LANES`], each step over a run's lanes at once.
+    pub(super) fn towards_at(&self, points: &[CellPoint], mut put: impl FnMut(usize, Toward)) {
+        let width = self.width as f32;
+        for (run, points) in points.chunks(LANES).enumerate() {
+            // Lanes past the run's points keep (harmless) zeros.
+            let mut cos_theta = [0.0; LANES];
+            let mut u = [0.0; LANES];
+            for (k, point) in points.iter().enumerate() {
+                let [fx, fy] = point.within;
+                let (top, bottom) = (self.row_cosines[point.row], self.row_cosines[point.row + 1]);
+                cos_theta[k] = (top + fy * (bottom - top)).clamp(-1.0, 1.0);
+                let phi = (point.column as f32 + 0.5 + fx) / width;
+                u[k] = if phi >= 1.0 { phi - 1.0 } else { phi }.min(ONE_BELOW);
+            }
+            let directions = self.directions_at(&cos_theta, &u);
+            for (k, point) in points.iter().enumerate() {
+                let location = MapLocation {
+                    u: u[k],
+                    cos_theta: cos_theta[k],
+                    cell: point.row * self.width + point.column,
+                };
+                put(
+                    run * LANES + k,
+                    Toward::from_environment(directions[k], Some(location)),
+                );
+            }
+        }
+    }
+
+    /// The world directions at (cos θ, u) of the map, lane by lane.
+    #[inline]
+    fn directions_at(&self, cos_theta: &[f32; LANES], u: &[f32; LANES]) -> [Vec3; LANES] {
+        let [x, y, z] = self.to_world.to_cols_array_2d();
+        std::array::from_fn(|k| {
+            let sin_theta = (1.0 - cos_theta[k] * cos_theta[k]).max(0.0).sqrt();
+            let (sin_phi, cos_phi) = fast_trig::sin_cos(2.0 * PI32 * u[k]);
+            let local = [sin_phi * sin_theta, cos_theta[k], -cos_phi * sin_theta];
+            let world = [0, 1, 2].map(|i| x[i] * local[0] + y[i] * local[1] + z[i] * local[2]);
+            let length = (world[0] * world[0] + world[1] * world[1] + world[2] * world[2]).sqrt();
+            Vec3::from(world) / length
+        })
     }
 
     /// The sampling density at `direction` (solid angle) and the cell it falls in.

@@ -8,6 +8,7 @@
 //! are independent and the core overlaps them. The directions, and so the images, are the
 //! same to the bit as one draw at a time ([`super::Lights::sample_toward`]).
 
+use super::environment::CellPoint;
 use super::environment_guide::Pick;
 use super::{Environment, EnvironmentGuide, EnvironmentMap, Lights, Receiver, Toward, ONE_BELOW};
 
@@ -143,7 +144,14 @@ impl EnvironmentDraws {
         for step in &mut steps[..count] {
             *step = step.second(map, guide);
         }
-        // Last step: the directions.
+        // Last step: the directions, all at once.
+        let mut points = [CellPoint {
+            row: 0,
+            column: 0,
+            within: [0.0; 2],
+        }; RUN];
+        let mut slots = [0; RUN];
+        let mut cells = 0;
         for (step, &slot) in steps[..count].iter().zip(&self.slots) {
             if let Step::Cell {
                 row,
@@ -151,9 +159,16 @@ impl EnvironmentDraws {
                 within,
             } = *step
             {
-                put(slot, map.toward_in_row_column(row, column, within));
+                points[cells] = CellPoint {
+                    row,
+                    column,
+                    within,
+                };
+                slots[cells] = slot;
+                cells += 1;
             }
         }
+        map.towards_at(&points[..cells], |k, toward| put(slots[k], toward));
     }
 }
 

@@ -100,7 +100,7 @@ trait Real:
 }
 
 macro_rules! real {
-    ($t:ty) => {
+    ($t:ty, $sin_cos:path) => {
         impl Real for $t {
             #[inline]
             fn of(value: f64) -> Self {
@@ -120,7 +120,7 @@ macro_rules! real {
             }
             #[inline]
             fn sin_cos(self) -> (Self, Self) {
-                <$t>::sin_cos(self)
+                $sin_cos(self)
             }
             #[inline]
             fn copysign(self, sign: Self) -> Self {
@@ -137,8 +137,9 @@ macro_rules! real {
         }
     };
 }
-real!(f32);
-real!(f64);
+// The f32 draws take sin and cos without libm (within 2e-7): a draw's one angle.
+real!(f32, ais::fast_trig::sin_cos);
+real!(f64, f64::sin_cos);
 
 impl Spherical<f64> {
     /// The same view in f32.

@@ -9,8 +9,8 @@ use std::f32::consts::{FRAC_1_PI, TAU};
 pub fn uniform_sphere(u: [f32; 2]) -> Vec3 {
     let z = 1.0 - 2.0 * u[0];
     let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = TAU * u[1];
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    let (sin_phi, cos_phi) = crate::fast_trig::sin_cos(TAU * u[1]);
+    Vec3::new(r * cos_phi, r * sin_phi, z)
 }
 
 /// The density of [`uniform_sphere`], 1 / 4π per steradian.
@@ -28,8 +28,8 @@ pub fn uniform_sphere_invert(direction: Vec3) -> [f32; 2] {
 #[inline]
 pub fn uniform_disk(u: [f32; 2]) -> [f32; 2] {
     let r = u[0].sqrt();
-    let phi = TAU * u[1];
-    [r * phi.cos(), r * phi.sin()]
+    let (sin_phi, cos_phi) = crate::fast_trig::sin_cos(TAU * u[1]);
+    [r * cos_phi, r * sin_phi]
 }
 
 /// A cosine-weighted direction around +z (density [`cosine_hemisphere_pdf`]), in local
