@@ -133,6 +133,16 @@ impl HitBsdf<'_> {
         }
     }
 
+    /// The shading frame of a single diffuse material, whose draws are
+    /// [`diffuse_direction`](super::diffuse_direction)s around it (`None`: another BSDF).
+    #[inline]
+    pub fn diffuse_frame(&self) -> Option<&ShadingFrame> {
+        match self {
+            HitBsdf::Single { material, frame } if material.is_diffuse() => Some(frame),
+            _ => None,
+        }
+    }
+
     /// A direction drawn from the BSDF: from a continuous part, or a point mass with its
     /// weight and probability (`None`: nothing scatters toward `wo`).
     #[inline]

@@ -340,13 +340,24 @@ impl Material {
         }
     }
 
+    /// Whether the BSDF is diffuse: its draws are then cosine-weighted around the shading
+    /// normal whatever the viewing direction ([`diffuse_direction`]).
+    pub fn is_diffuse(&self) -> bool {
+        matches!(self.scattering, Scattering::Diffuse { .. })
+    }
+
     /// A direction drawn from the BSDF for viewing direction `wo`: from its continuous part,
     /// or a specular lobe with its mass (`None`: nothing scatters toward `wo`).
     pub fn sample_lobe(&self, frame: &ShadingFrame, wo: Vec3, u: [f32; 2]) -> Option<BsdfSample> {
         let o = frame.to_local(wo);
         let reflect = |h: Vec3| 2.0 * o.dot(h) * h - o;
         let local = match self.scattering {
-            Scattering::Diffuse { .. } => specular::LobeSample::Continuous(cosine_hemisphere(u)),
+            Scattering::Diffuse { .. } => {
+                return Some(BsdfSample {
+                    direction: diffuse_direction(frame, u),
+                    specular: None,
+                })
+            }
             Scattering::RoughConductor { microfacet, .. } => (o.z > 0.0)
                 .then(|| specular::LobeSample::Continuous(reflect(microfacet.sample(o, u))))?,
             Scattering::RoughPlastic(ref plastic) => {
@@ -439,6 +450,12 @@ impl Material {
     }
 }
 
+/// A diffuse BSDF's draw from `u`: cosine-weighted around `frame`'s normal. Inline, so that a
+/// run's draws in a loop are worked out in lanes.
+#[inline(always)]
+pub fn diffuse_direction(frame: &ShadingFrame, u: [f32; 2]) -> Vec3 {
+    frame.to_world(cosine_hemisphere(u)).normalize()
+}
 #[cfg(test)]
 mod tests {
     use super::*;

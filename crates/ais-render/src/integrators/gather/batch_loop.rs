@@ -7,9 +7,9 @@ use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
 use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
-use super::strategy::{GatherPoint, MisParts};
+use super::strategy::{CandidateDraw, GatherPoint, MisParts};
 use crate::geometry::LastBlocker;
-use crate::lights::{luminance, Draw, EnvironmentDraws, Toward};
+use crate::lights::{luminance, EnvironmentDraws, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
@@ -265,11 +265,19 @@ fn keep_in_support(at: &GatherPoint, drawn: &mut [Option<Toward>]) -> usize {
 /// step, so that one draw's table lookups overlap the next's.
 fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>]) {
     let mut environment = EnvironmentDraws::default();
+    let mut bsdf_numbers = [[0.0; 2]; AHEAD];
+    let mut bsdf_slots = [0; AHEAD];
+    let mut bsdf_draws = 0;
     for (k, (&u, slot)) in numbers.iter().zip(slots.iter_mut()).enumerate() {
         *slot = match run.sampler.begin_direction(run.at, u) {
-            Draw::Made(toward) => toward,
-            Draw::Environment(u) => {
+            CandidateDraw::Made(toward) => toward,
+            CandidateDraw::Environment(u) => {
                 environment.push(k, u);
+                None
+            }
+            CandidateDraw::Bsdf(u) => {
+                (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
+                bsdf_draws += 1;
                 None
             }
         };
@@ -277,6 +285,10 @@ fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>])
     environment.draw(run.at.lights, &run.at.receiver, |k, toward| {
         slots[k] = Some(toward)
     });
+    run.at
+        .draw_bsdf_run(&bsdf_numbers[..bsdf_draws], |k, toward| {
+            slots[bsdf_slots[k]] = toward
+        });
 }
 
 /// Draws and decides candidates until [`AHEAD`] are to be traced or the batch is complete;

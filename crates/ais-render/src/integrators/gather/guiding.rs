@@ -16,8 +16,8 @@
 //! Both keep a share of the unguided density everywhere, so the estimate is exactly
 //! unbiased whatever the map says, and a wrong map costs at most `1 / (1 − α)` in variance.
 
-use super::strategy::{GatherPoint, MisParts, Strategy};
-use crate::lights::{Draw, Environment, EnvironmentGuide, Toward};
+use super::strategy::{CandidateDraw, GatherPoint, MisParts, Strategy};
+use crate::lights::{Environment, EnvironmentGuide, Toward};
 use ais::mapping::LatLong;
 use ais::{AffinityMap, TexelDistribution};
 
@@ -68,13 +68,13 @@ impl<'a> CandidateSampler<'a> {
     ///
     /// [`EnvironmentDraws`]: crate::lights::EnvironmentDraws
     #[inline]
-    pub fn begin_direction(&self, at: &GatherPoint, u: [f32; 2]) -> Draw {
+    pub fn begin_direction(&self, at: &GatherPoint, u: [f32; 2]) -> CandidateDraw {
         let Some(guide) = self.guide else {
             return self.strategy.begin_direction(at, u);
         };
         let alpha = self.fraction;
         if u[0] < alpha {
-            Draw::Made(Some(Toward::new(guide.sample([u[0] / alpha, u[1]]))))
+            CandidateDraw::Made(Some(Toward::new(guide.sample([u[0] / alpha, u[1]]))))
         } else {
             let rescaled = ((u[0] - alpha) / (1.0 - alpha)).min(1.0 - 1e-7);
             self.strategy.begin_direction(at, [rescaled, u[1]])

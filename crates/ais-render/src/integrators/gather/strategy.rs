@@ -1,7 +1,7 @@
 //! Proposal samplers for the gather: uniform, BSDF, light, and their MIS mixture. Each gives
 //! a direction and the density of the whole strategy at that direction.
 
-use crate::bsdf::{HitBsdf, ShadingFrame, SurfacePoint};
+use crate::bsdf::{diffuse_direction, HitBsdf, ShadingFrame, SurfacePoint};
 use crate::geometry::Hit;
 use crate::lights::{Draw, Lights, Receiver, Toward};
 use crate::world::World;
@@ -112,8 +112,35 @@ impl GatherPoint<'_> {
 
     /// The direction of a draw, made now if it was left for later.
     #[inline]
-    pub fn finish(&self, draw: Draw) -> Option<Toward> {
-        self.lights.finish(&self.receiver, draw)
+    pub fn finish(&self, draw: CandidateDraw) -> Option<Toward> {
+        match draw {
+            CandidateDraw::Made(toward) => toward,
+            CandidateDraw::Environment(u) => {
+                self.lights.finish(&self.receiver, Draw::Environment(u))
+            }
+            CandidateDraw::Bsdf(u) => self.sample_bsdf(u),
+        }
+    }
+
+    /// The BSDF's draws for `numbers`, each given to `put` with its index: a diffuse
+    /// material's worked out over the run's lanes at once, another's one by one. The same
+    /// directions as [`GatherPoint::finish`] gives.
+    pub fn draw_bsdf_run(&self, numbers: &[[f32; 2]], mut put: impl FnMut(usize, Option<Toward>)) {
+        let Some(frame) = self.bsdf.diffuse_frame() else {
+            for (k, &u) in numbers.iter().enumerate() {
+                put(k, self.sample_bsdf(u));
+            }
+            return;
+        };
+        for (run, numbers) in numbers.chunks(BSDF_LANES).enumerate() {
+            let mut lanes = [[0.0; 2]; BSDF_LANES];
+            lanes[..numbers.len()].copy_from_slice(numbers);
+            let directions: [Vec3; BSDF_LANES] =
+                std::array::from_fn(|k| diffuse_direction(frame, lanes[k]));
+            for (k, &direction) in directions[..numbers.len()].iter().enumerate() {
+                put(run * BSDF_LANES + k, Some(Toward::new(direction)));
+            }
+        }
     }
 
     /// A direction drawn from the BSDF (`None`: nothing scatters toward the viewer).
@@ -124,6 +151,31 @@ impl GatherPoint<'_> {
             Some(mass) => Toward::specular(sample.direction, mass),
             None => Toward::new(sample.direction),
         })
+    }
+}
+
+/// How many BSDF draws [`GatherPoint::draw_bsdf_run`] works out at once.
+const BSDF_LANES: usize = 16;
+
+/// A candidate's draw from a proposal: made, or left to be made with the run's other draws
+/// of its kind (an environment map's, [`crate::lights::EnvironmentDraws`]; a BSDF's,
+/// [`GatherPoint::draw_bsdf_run`]).
+#[derive(Clone, Copy, Debug)]
+pub enum CandidateDraw {
+    /// The draw is made (`None`: no direction).
+    Made(Option<Toward>),
+    /// A direction from the environment map for these numbers is still to be drawn.
+    Environment([f32; 2]),
+    /// A direction from the BSDF for these numbers is still to be drawn.
+    Bsdf([f32; 2]),
+}
+
+impl From<Draw> for CandidateDraw {
+    fn from(draw: Draw) -> Self {
+        match draw {
+            Draw::Made(toward) => CandidateDraw::Made(toward),
+            Draw::Environment(u) => CandidateDraw::Environment(u),
+        }
     }
 }
 
@@ -181,18 +233,18 @@ impl Strategy {
     ///
     /// [`EnvironmentDraws`]: crate::lights::EnvironmentDraws
     #[inline]
-    pub fn begin_direction(self, at: &GatherPoint, u: [f32; 2]) -> Draw {
+    pub fn begin_direction(self, at: &GatherPoint, u: [f32; 2]) -> CandidateDraw {
         match self.effective(at) {
-            Strategy::Uniform => Draw::Made(Some(Toward::new(uniform_sphere(u)))),
-            Strategy::Bsdf => Draw::Made(at.sample_bsdf(u)),
-            Strategy::Light => at.lights.begin_sample(&at.receiver, u),
+            Strategy::Uniform => CandidateDraw::Made(Some(Toward::new(uniform_sphere(u)))),
+            Strategy::Bsdf => CandidateDraw::Bsdf(u),
+            Strategy::Light => at.lights.begin_sample(&at.receiver, u).into(),
             Strategy::Mis => {
                 let w = at.mis_bsdf_share as f32;
                 if u[0] < w {
-                    Draw::Made(at.sample_bsdf([u[0] / w, u[1]]))
+                    CandidateDraw::Bsdf([u[0] / w, u[1]])
                 } else {
                     let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
-                    at.lights.begin_sample(&at.receiver, [u0, u[1]])
+                    at.lights.begin_sample(&at.receiver, [u0, u[1]]).into()
                 }
             }
         }
