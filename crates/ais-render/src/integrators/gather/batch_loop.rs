@@ -262,7 +262,8 @@ fn keep_in_support(at: &GatherPoint, drawn: &mut [Option<Toward>]) -> usize {
 
 /// Draws the candidates of `numbers` into `slots` (as many), in order: `None` where no
 /// direction could be drawn. The environment map's draws are made all together, step by
-/// step, so that one draw's table lookups overlap the next's.
+/// step, so that one draw's table lookups overlap the next's; the BSDF's after them (a
+/// diffuse material's over the run's lanes at once).
 fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>]) {
     let mut environment = EnvironmentDraws::default();
     let mut bsdf_numbers = [[0.0; 2]; AHEAD];
