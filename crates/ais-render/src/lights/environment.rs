@@ -279,32 +279,28 @@ impl EnvironmentMap {
         column: usize,
         within: [f32; 2],
     ) -> Toward {
-        let mut toward = None;
-        let cell = CellPoint {
+        let location = self.location_at(&CellPoint {
             row,
             column,
             within,
-        };
-        self.towards_at(&[cell], |_, drawn| toward = Some(drawn));
-        toward.expect("a direction for every cell point")
+        });
+        let direction = self.direction_from(location.cos_theta, location.u);
+        Toward::from_environment(direction, Some(location))
     }
 
     /// [`EnvironmentMap::toward_in_row_column`] for each of `points`, given to `put` with
-    /// its index: worked out in runs of [`LANES`], each step over a run's lanes at once.
+    /// its index: worked out in runs of [`LANES`], the directions over a run's lanes at once.
     pub(super) fn towards_at(&self, points: &[CellPoint], mut put: impl FnMut(usize, Toward)) {
-        let width = self.width as f32;
         for (run, points) in points.chunks(LANES).enumerate() {
             // Lanes past the run's points keep (harmless) zeros.
             let mut cos_theta = [0.0; LANES];
             let mut u = [0.0; LANES];
             for (k, point) in points.iter().enumerate() {
-                let [fx, fy] = point.within;
-                let (top, bottom) = (self.row_cosines[point.row], self.row_cosines[point.row + 1]);
-                cos_theta[k] = (top + fy * (bottom - top)).clamp(-1.0, 1.0);
-                let phi = (point.column as f32 + 0.5 + fx) / width;
-                u[k] = if phi >= 1.0 { phi - 1.0 } else { phi }.min(ONE_BELOW);
+                let location = self.location_at(point);
+                (cos_theta[k], u[k]) = (location.cos_theta, location.u);
             }
-            let directions = self.directions_at(&cos_theta, &u);
+            let directions: [Vec3; LANES] =
+                std::array::from_fn(|k| self.direction_from(cos_theta[k], u[k]));
             for (k, point) in points.iter().enumerate() {
                 let location = MapLocation {
                     u: u[k],
@@ -319,18 +315,30 @@ impl EnvironmentMap {
         }
     }
 
-    /// The world directions at (cos θ, u) of the map, lane by lane.
-    #[inline]
-    fn directions_at(&self, cos_theta: &[f32; LANES], u: &[f32; LANES]) -> [Vec3; LANES] {
+    /// Where a cell point falls on the map: its u, cos θ and cell.
+    #[inline(always)]
+    fn location_at(&self, point: &CellPoint) -> MapLocation {
+        let [fx, fy] = point.within;
+        let (top, bottom) = (self.row_cosines[point.row], self.row_cosines[point.row + 1]);
+        let phi = (point.column as f32 + 0.5 + fx) / self.width as f32;
+        MapLocation {
+            u: if phi >= 1.0 { phi - 1.0 } else { phi }.min(ONE_BELOW),
+            cos_theta: (top + fy * (bottom - top)).clamp(-1.0, 1.0),
+            cell: point.row * self.width + point.column,
+        }
+    }
+
+    /// The world direction at (cos θ, u) of the map. Inline, without a branch, so that a
+    /// loop of them runs in lanes.
+    #[inline(always)]
+    fn direction_from(&self, cos_theta: f32, u: f32) -> Vec3 {
         let [x, y, z] = self.to_world.to_cols_array_2d();
-        std::array::from_fn(|k| {
-            let sin_theta = (1.0 - cos_theta[k] * cos_theta[k]).max(0.0).sqrt();
-            let (sin_phi, cos_phi) = fast_trig::sin_cos(2.0 * PI32 * u[k]);
-            let local = [sin_phi * sin_theta, cos_theta[k], -cos_phi * sin_theta];
-            let world = [0, 1, 2].map(|i| x[i] * local[0] + y[i] * local[1] + z[i] * local[2]);
-            let length = (world[0] * world[0] + world[1] * world[1] + world[2] * world[2]).sqrt();
-            Vec3::from(world) / length
-        })
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = fast_trig::sin_cos(2.0 * PI32 * u);
+        let local = [sin_phi * sin_theta, cos_theta, -cos_phi * sin_theta];
+        let world = [0, 1, 2].map(|i| x[i] * local[0] + y[i] * local[1] + z[i] * local[2]);
+        let length = (world[0] * world[0] + world[1] * world[1] + world[2] * world[2]).sqrt();
+        Vec3::from(world) / length
     }
 
     /// The sampling density at `direction` (solid angle) and the cell it falls in.
