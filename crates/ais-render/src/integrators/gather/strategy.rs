@@ -133,10 +133,11 @@ impl GatherPoint<'_> {
             return;
         };
         for (run, numbers) in numbers.chunks(BSDF_LANES).enumerate() {
-            let mut lanes = [[0.0; 2]; BSDF_LANES];
-            lanes[..numbers.len()].copy_from_slice(numbers);
-            let directions: [Vec3; BSDF_LANES] =
-                std::array::from_fn(|k| diffuse_direction(frame, lanes[k]));
+            // As many lanes as draws: a short run does not pay for sixteen.
+            let mut directions = [Vec3::ZERO; BSDF_LANES];
+            for (direction, &u) in directions.iter_mut().zip(numbers) {
+                *direction = diffuse_direction(frame, u);
+            }
             for (k, &direction) in directions[..numbers.len()].iter().enumerate() {
                 put(run * BSDF_LANES + k, Some(Toward::new(direction)));
             }
