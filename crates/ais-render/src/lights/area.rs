@@ -214,11 +214,7 @@ impl AreaLight {
     #[inline]
     pub fn sample_for(&self, receiver: &Receiver, u: [f32; 2]) -> Option<AreaSample> {
         let point = receiver.point;
-        if receiver
-            .support_side
-            .is_some_and(|side| self.wholly_behind(point, side))
-        {
-            // Every draw would fall outside the receiver's support.
+        if self.out_of_reach(receiver) {
             return None;
         }
         match &self.shape {
@@ -284,6 +280,22 @@ impl AreaLight {
                 (sample.pdf.is_finite() && sample.pdf > 0.0).then_some(sample)
             }
             AreaShape::Triangles(mesh) => mesh.sample(point, u),
+        }
+    }
+
+    /// Whether every draw from `receiver` would fall outside its support: the light lies
+    /// wholly behind it.
+    #[inline]
+    pub(super) fn out_of_reach(&self, receiver: &Receiver) -> bool {
+        (receiver.support_side).is_some_and(|side| self.wholly_behind(receiver.point, side))
+    }
+
+    /// The rectangle of a rectangle light.
+    #[inline]
+    pub(super) fn rectangle(&self) -> Option<&Rectangle> {
+        match &self.shape {
+            AreaShape::Rectangle(rectangle) => Some(rectangle),
+            _ => None,
         }
     }
 

@@ -10,20 +10,12 @@
 
 use super::environment::CellPoint;
 use super::environment_guide::Pick;
+#[cfg(test)]
+use super::Draw;
 use super::{Environment, EnvironmentGuide, EnvironmentMap, Lights, Receiver, Toward, ONE_BELOW};
 
 /// The most draws a run holds.
 pub const RUN: usize = 16;
-
-/// A candidate's draw: made, or (toward an environment map) left to be made with other
-/// candidates' in [`EnvironmentDraws`].
-#[derive(Clone, Copy, Debug)]
-pub enum Draw {
-    /// The draw is made (`None`: no direction).
-    Made(Option<Toward>),
-    /// A direction from the environment map for these numbers is still to be drawn.
-    Environment([f32; 2]),
-}
 
 /// Where one environment draw stands between steps.
 #[derive(Clone, Copy, Debug)]

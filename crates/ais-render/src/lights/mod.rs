@@ -4,23 +4,27 @@
 
 mod area;
 mod delta;
+mod draw;
 mod environment;
 mod environment_draws;
 mod environment_guide;
 mod mesh_emitter;
 pub(crate) mod reader;
 mod receiver;
+mod rectangle_draws;
 mod regions;
 mod spherical_rectangle;
 mod toward;
 
 pub use area::{AreaHit, AreaLight, AreaSample, AreaShape, LightSpot};
 pub use delta::{DeltaArrival, DeltaLight, Spot};
+pub use draw::Draw;
 pub use environment::{luminance, Environment, EnvironmentMap};
-pub use environment_draws::{Draw, EnvironmentDraws};
+pub use environment_draws::EnvironmentDraws;
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout};
 pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
+pub use rectangle_draws::{AreaChoice, RectangleDraw, RectangleDraws};
 pub use regions::{region_of, RegionChoice, REGIONS, REGION_SIDE};
 pub use spherical_rectangle::{Rectangle, LEAST_F32_SOLID_ANGLE};
 pub use toward::Toward;
@@ -233,11 +237,17 @@ impl Lights {
         match draw {
             Draw::Made(toward) => toward,
             Draw::Environment(u) => self.environment_toward(receiver, u),
+            Draw::Rectangle(draw) => {
+                let light = &self.area[draw.choice.light];
+                let sample = light.sample_for(receiver, draw.square)?;
+                Some(self.area_toward(receiver, draw.choice, &sample))
+            }
         }
     }
 
-    /// [`Lights::sample_toward`], except that a draw from an environment map is left to be
-    /// made together with other candidates' ([`EnvironmentDraws`]).
+    /// [`Lights::sample_toward`], except that a draw from an environment map or a rectangle
+    /// light is left to be made together with other candidates' ([`EnvironmentDraws`],
+    /// [`RectangleDraws`]).
     #[inline]
     pub fn begin_sample(&self, receiver: &Receiver, u: [f32; 2]) -> Draw {
         let Some(choice) = self.choice_for(receiver) else {
@@ -246,7 +256,7 @@ impl Lights {
         let (index, u0) = choice.sample(u[0]);
         if index < self.area.len() {
             let probability = choice.probability(index) as f64;
-            return Draw::Made(self.sample_area(receiver, index, probability, [u0, u[1]]));
+            return self.begin_area(receiver, index, probability, [u0, u[1]]);
         }
         if index < self.environment_index() {
             let delta = index - self.area.len();
@@ -260,15 +270,15 @@ impl Lights {
     }
 
     /// A point of area light `index` (chosen with `probability`) drawn from `square` for
-    /// `receiver`.
+    /// `receiver`: made now, or, for a rectangle, left to be made with the run's others.
     #[inline]
-    fn sample_area(
+    fn begin_area(
         &self,
         receiver: &Receiver,
         index: usize,
         probability: f64,
         square: [f32; 2],
-    ) -> Option<Toward> {
+    ) -> Draw {
         let light = &self.area[index];
         // A receiver that weighs the light's regions draws the square's point from them.
         let (square, region, factor) = match receiver.region_choice(index) {
@@ -278,16 +288,32 @@ impl Lights {
             }
             None => (square, region_of(square), 1.0),
         };
-        let sample = light.sample_for(receiver, square)?;
+        let choice = AreaChoice {
+            light: index,
+            probability,
+            factor,
+            region: region as u8,
+        };
+        if light.rectangle().is_some() && !light.out_of_reach(receiver) {
+            return Draw::Rectangle(RectangleDraw { choice, square });
+        }
+        let sample = light.sample_for(receiver, square);
+        Draw::Made(sample.map(|sample| self.area_toward(receiver, choice, &sample)))
+    }
+
+    /// The candidate toward the point `sample` drew on the light of `choice`.
+    #[inline]
+    fn area_toward(&self, receiver: &Receiver, choice: AreaChoice, sample: &AreaSample) -> Toward {
+        let light = &self.area[choice.light];
         let target = receiver.point + sample.direction * sample.distance;
         let point = AreaPoint {
-            light: index,
+            light: choice.light,
             target,
             radiance: light.emitted(sample.normal, sample.direction, target, sample.spot),
-            density: probability * sample.pdf * factor,
-            region: Some(region as u8),
+            density: choice.probability * sample.pdf * choice.factor,
+            region: Some(choice.region),
         };
-        Some(Toward::area(sample.direction, point))
+        Toward::area(sample.direction, point)
     }
 
     /// The environment's direction from `u` (drawn by the receiver's guide when it has one).

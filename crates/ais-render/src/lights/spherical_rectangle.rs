@@ -30,6 +30,9 @@ pub struct Rectangle {
 /// Cornell-box frame, where these draws are a sixth of it.
 pub const LEAST_F32_SOLID_ANGLE: f64 = 1e-3;
 
+/// How many f32 draws [`Rectangle::sample_view_run`] works out at once.
+const LANES: usize = 16;
+
 /// The spherical rectangle seen from one point: everything the sampler needs, in f32
 /// where that is precise enough ([`LEAST_F32_SOLID_ANGLE`]), else in f64.
 #[derive(Clone, Copy, Debug)]
@@ -130,9 +133,16 @@ macro_rules! real {
             fn max(self, other: Self) -> Self {
                 <$t>::max(self, other)
             }
-            #[inline]
+            /// `clamp`'s answer (for `low <= high`) by two selects, with no assertion: a
+            /// loop of draws runs in lanes.
+            #[inline(always)]
             fn clamp(self, low: Self, high: Self) -> Self {
-                <$t>::clamp(self, low, high)
+                let above = if self < low { low } else { self };
+                if above > high {
+                    high
+                } else {
+                    above
+                }
             }
         }
     };
@@ -165,8 +175,9 @@ impl Spherical<f64> {
 
 impl<R: Real> Spherical<R> {
     /// The direction for `u` (uniform over the solid angle when `u` is uniform) and the
-    /// distance to the point drawn.
-    #[inline]
+    /// distance to the point drawn. Inline and without a branch, so that a loop of draws
+    /// runs in lanes.
+    #[inline(always)]
     fn sample(&self, u: [f32; 2]) -> (Vec3, f32) {
         let one = R::of(1.0);
         let au = R::of(u[0] as f64) * self.solid_angle + self.k;
@@ -184,9 +195,11 @@ impl<R: Real> Spherical<R> {
         let h1 = self.y1 / (distance_squared + self.y1 * self.y1).sqrt();
         let hv = h0 + R::of(u[1] as f64) * (h1 - h0);
         let hv2 = hv * hv;
-        // (In f32, 1 − 1e-12 rounds to 1.)
+        // (In f32, 1 − 1e-12 rounds to 1.) Worked out either way and then selected, for
+        // the lanes: at the edge the quotient is not finite, and not taken.
+        let inside = (hv * distance / (one - hv2).sqrt()).clamp(self.y0, self.y1);
         let yv = if hv2 < one - R::of(1e-12) {
-            (hv * distance / (one - hv2).sqrt()).clamp(self.y0, self.y1)
+            inside
         } else {
             self.y1
         };
@@ -324,6 +337,33 @@ impl Rectangle {
             Draws::Precise(precise) => precise.sample(u),
         };
         (direction, 1.0 / view.solid_angle, distance)
+    }
+
+    /// [`Rectangle::sample_view`] for each of `numbers`, given to `put` with its index, the
+    /// direction, the density and the distance: an f32 view's draws worked out over runs of
+    /// [`LANES`] at once, to the bit as one at a time.
+    pub(crate) fn sample_view_run(
+        view: &View,
+        numbers: &[[f32; 2]],
+        mut put: impl FnMut(usize, Vec3, f64, f32),
+    ) {
+        let pdf = 1.0 / view.solid_angle;
+        let Draws::Fast(fast) = &view.draws else {
+            for (k, &u) in numbers.iter().enumerate() {
+                let (direction, pdf, distance) = Self::sample_view(view, u);
+                put(k, direction, pdf, distance);
+            }
+            return;
+        };
+        for (run, numbers) in numbers.chunks(LANES).enumerate() {
+            // Lanes past the run's numbers draw from (harmless) zeros.
+            let mut lanes = [[0.0; 2]; LANES];
+            lanes[..numbers.len()].copy_from_slice(numbers);
+            let drawn: [(Vec3, f32); LANES] = std::array::from_fn(|k| fast.sample(lanes[k]));
+            for (k, &(direction, distance)) in drawn[..numbers.len()].iter().enumerate() {
+                put(run * LANES + k, direction, pdf, distance);
+            }
+        }
     }
 
     /// The point of the sample square that [`Rectangle::sample_view`] maps to the point

@@ -9,7 +9,7 @@ use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
 use super::strategy::{CandidateDraw, GatherPoint, MisParts};
 use crate::geometry::LastBlocker;
-use crate::lights::{luminance, EnvironmentDraws, Toward};
+use crate::lights::{luminance, EnvironmentDraws, RectangleDraws, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
@@ -262,10 +262,12 @@ fn keep_in_support(at: &GatherPoint, drawn: &mut [Option<Toward>]) -> usize {
 
 /// Draws the candidates of `numbers` into `slots` (as many), in order: `None` where no
 /// direction could be drawn. The environment map's draws are made all together, step by
-/// step, so that one draw's table lookups overlap the next's; the BSDF's after them (a
-/// diffuse material's over the run's lanes at once).
+/// step, so that one draw's table lookups overlap the next's; a rectangle light's after
+/// them, over the run's lanes at once, and the BSDF's last (a diffuse material's in lanes
+/// too).
 fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>]) {
     let mut environment = EnvironmentDraws::default();
+    let mut rectangles = RectangleDraws::default();
     let mut bsdf_numbers = [[0.0; 2]; AHEAD];
     let mut bsdf_slots = [0; AHEAD];
     let mut bsdf_draws = 0;
@@ -276,6 +278,10 @@ fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>])
                 environment.push(k, u);
                 None
             }
+            CandidateDraw::Rectangle(draw) => {
+                rectangles.push(k, draw);
+                None
+            }
             CandidateDraw::Bsdf(u) => {
                 (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
                 bsdf_draws += 1;
@@ -284,6 +290,9 @@ fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>])
         };
     }
     environment.draw(run.at.lights, &run.at.receiver, |k, toward| {
+        slots[k] = Some(toward)
+    });
+    rectangles.draw(run.at.lights, &run.at.receiver, |k, toward| {
         slots[k] = Some(toward)
     });
     run.at

@@ -3,7 +3,7 @@
 
 use crate::bsdf::{diffuse_direction, HitBsdf, ShadingFrame, SurfacePoint};
 use crate::geometry::Hit;
-use crate::lights::{Draw, Lights, Receiver, Toward};
+use crate::lights::{Draw, Lights, Receiver, RectangleDraw, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
@@ -118,6 +118,9 @@ impl GatherPoint<'_> {
             CandidateDraw::Environment(u) => {
                 self.lights.finish(&self.receiver, Draw::Environment(u))
             }
+            CandidateDraw::Rectangle(draw) => {
+                self.lights.finish(&self.receiver, Draw::Rectangle(draw))
+            }
             CandidateDraw::Bsdf(u) => self.sample_bsdf(u),
         }
     }
@@ -159,14 +162,16 @@ impl GatherPoint<'_> {
 const BSDF_LANES: usize = 16;
 
 /// A candidate's draw from a proposal: made, or left to be made with the run's other draws
-/// of its kind (an environment map's, [`crate::lights::EnvironmentDraws`]; a BSDF's,
-/// [`GatherPoint::draw_bsdf_run`]).
+/// of its kind (an environment map's, [`crate::lights::EnvironmentDraws`]; a rectangle
+/// light's, [`crate::lights::RectangleDraws`]; a BSDF's, [`GatherPoint::draw_bsdf_run`]).
 #[derive(Clone, Copy, Debug)]
 pub enum CandidateDraw {
     /// The draw is made (`None`: no direction).
     Made(Option<Toward>),
     /// A direction from the environment map for these numbers is still to be drawn.
     Environment([f32; 2]),
+    /// A point of a rectangle light is still to be drawn.
+    Rectangle(RectangleDraw),
     /// A direction from the BSDF for these numbers is still to be drawn.
     Bsdf([f32; 2]),
 }
@@ -176,6 +181,7 @@ impl From<Draw> for CandidateDraw {
         match draw {
             Draw::Made(toward) => CandidateDraw::Made(toward),
             Draw::Environment(u) => CandidateDraw::Environment(u),
+            Draw::Rectangle(draw) => CandidateDraw::Rectangle(draw),
         }
     }
 }
