@@ -13,6 +13,7 @@ pub(crate) mod reader;
 mod receiver;
 mod rectangle_draws;
 mod regions;
+mod resolve;
 mod spherical_rectangle;
 mod toward;
 
@@ -53,6 +54,9 @@ pub struct Lights {
     choice: Option<AliasTable>,
     /// Where a field cell counts each light's rays ([`Lights::source_of`]).
     sources: SourceLayout,
+    /// Whether there are area lights and all are rectangles: a run's directions are then
+    /// resolved together ([`Lights::resolve_run`]).
+    only_rectangles: bool,
 }
 
 /// Where a field cell counts each light's rays: one source per light, or, for the lights
@@ -124,6 +128,7 @@ impl Lights {
         let mut regions: Vec<bool> = area.iter().map(AreaLight::has_regions).collect();
         regions.resize(weights.len(), false);
         Lights {
+            only_rectangles: !area.is_empty() && area.iter().all(|l| l.rectangle().is_some()),
             environment,
             area,
             delta,
@@ -441,40 +446,6 @@ impl Lights {
         }
         self.target(receiver, toward)
             .map_or(Aim::Unbounded, Aim::Point)
-    }
-
-    /// Finds what a direction of unknown source meets first among the emitters: the nearest
-    /// area light along it, else the environment.
-    fn resolve(&self, receiver: &Receiver, toward: &mut Toward) {
-        if !matches!(toward.source, Source::Unknown) {
-            return;
-        }
-        let ray = Ray::new(receiver.point, toward.direction);
-        let nearest = self
-            .area
-            .iter()
-            .enumerate()
-            .filter_map(|(index, light)| light.intersect(&ray).map(|hit| (hit, index)))
-            .min_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
-        toward.source = match nearest {
-            Some((hit, index)) => {
-                let light = &self.area[index];
-                let density =
-                    light.density_at(receiver, toward.direction, hit.distance, hit.normal);
-                let target = receiver.point + toward.direction * hit.distance;
-                let (factor, region) =
-                    self.region_factor(receiver, index, toward.direction, Some(target));
-                Source::Area(AreaPoint {
-                    light: index,
-                    target,
-                    radiance: light.emitted(hit.normal, toward.direction, target, hit.spot),
-                    density: self.choice_probability(receiver, index) * density * factor,
-                    region,
-                })
-            }
-            None if self.environment.is_some() => Source::Environment,
-            None => Source::Dark,
-        };
     }
 
     /// The factor that `receiver`'s weighing of area light `index`'s regions puts on the

@@ -30,8 +30,9 @@ pub struct Rectangle {
 /// Cornell-box frame, where these draws are a sixth of it.
 pub const LEAST_F32_SOLID_ANGLE: f64 = 1e-3;
 
-/// How many f32 draws [`Rectangle::sample_view_run`] works out at once.
-const LANES: usize = 16;
+/// How many f32 draws [`Rectangle::sample_view_run`], and how many rays
+/// [`Rectangle::distances_along`], works out at once.
+pub(crate) const LANES: usize = 16;
 
 /// The spherical rectangle seen from one point: everything the sampler needs, in f32
 /// where that is precise enough ([`LEAST_F32_SOLID_ANGLE`]), else in f64.
@@ -382,18 +383,32 @@ impl Rectangle {
 
     /// Distance along the ray to the rectangle, if it hits it (either side).
     pub fn intersect(&self, ray: &Ray) -> Option<f32> {
+        let t = self.distance_along(ray);
+        (t != f32::INFINITY).then_some(t)
+    }
+
+    /// [`Rectangle::intersect`] for unbounded rays from `origin` along each of
+    /// `directions`, worked out over the lanes at once (infinite where a ray misses).
+    pub(crate) fn distances_along(&self, origin: Vec3, directions: &[Vec3; LANES]) -> [f32; LANES] {
+        std::array::from_fn(|k| self.distance_along(&Ray::new(origin, directions[k])))
+    }
+
+    /// The distance along `ray` to the rectangle, infinite where it misses. Every test is
+    /// made and then combined, with no branch, so that a loop of rays runs in lanes.
+    #[inline(always)]
+    fn distance_along(&self, ray: &Ray) -> f32 {
         let denominator = ray.direction.dot(self.normal);
-        if denominator.abs() < 1e-12 {
-            return None;
-        }
         let t = (self.corner - ray.origin).dot(self.normal) / denominator;
-        if !(t > 0.0 && t < ray.t_max) {
-            return None;
-        }
         let local = ray.at(t) - self.corner;
         let a = local.dot(self.edge_x) / self.edge_x.length_squared();
         let b = local.dot(self.edge_y) / self.edge_y.length_squared();
-        ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some(t)
+        let within = |c: f32| (0.0..=1.0).contains(&c);
+        let hit = (denominator.abs() >= 1e-12) & (t > 0.0) & (t < ray.t_max);
+        if hit & within(a) & within(b) {
+            t
+        } else {
+            f32::INFINITY
+        }
     }
 }
 

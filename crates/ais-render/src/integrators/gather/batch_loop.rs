@@ -189,8 +189,8 @@ struct ShadowRays<'a> {
     last_blocker: &'a mut LastBlocker,
 }
 
-/// Traces the shadow rays of a run of drawn candidates (`drawn`; empty slots are passed
-/// over), then looks up what the free ones bring into `arriving` (from its start, in the
+/// Finds what the drawn candidates of a run meet among the lights, together (`drawn`; empty
+/// slots are passed over), traces their shadow rays, then looks up what the free ones bring into `arriving` (from its start, in the
 /// order of the filled slots): all the lookups after all the rays, so that they overlap.
 fn trace_run(
     run: &BatchRun,
@@ -198,6 +198,7 @@ fn trace_run(
     arriving: &mut [ShadowRay; AHEAD],
     rays: ShadowRays,
 ) {
+    run.world.lights.resolve_run(&run.at.receiver, drawn);
     let mut blocked = [None; AHEAD];
     for (toward, blocked) in drawn.iter_mut().flatten().zip(&mut blocked) {
         *blocked = trace_aimed(run.world, run.at, toward, rays.counts, rays.last_blocker);

@@ -1,0 +1,179 @@
+//! What a direction drawn without the lights (from a BSDF, a guide) meets first among the
+//! emitters: the nearest area light along it, else the environment. One direction at a
+//! time, or, where the area lights are rectangles, a run's directions together, each
+//! light tested against all of them over vector lanes ([`super::Rectangle::distances_along`]);
+//! both find the same sources, to the bit.
+
+use super::spherical_rectangle::LANES;
+use super::toward::{AreaPoint, Source};
+use super::{AreaHit, LightSpot, Lights, Receiver, Toward};
+use crate::geometry::Ray;
+use glam::Vec3;
+
+/// The nearest area light found along a direction so far: its hit and its index.
+type Nearest = Option<(AreaHit, usize)>;
+
+impl Lights {
+    /// Finds what `toward` meets first among the emitters, if not known yet.
+    pub(super) fn resolve(&self, receiver: &Receiver, toward: &mut Toward) {
+        if !matches!(toward.source, Source::Unknown) {
+            return;
+        }
+        let ray = Ray::new(receiver.point, toward.direction);
+        let nearest = self
+            .area
+            .iter()
+            .enumerate()
+            .filter_map(|(index, light)| light.intersect(&ray).map(|hit| (hit, index)))
+            .min_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
+        toward.source = self.source_at(receiver, toward.direction, nearest);
+    }
+
+    /// Finds what each candidate of `drawn` (empty slots passed over) meets first among the
+    /// emitters, where not known yet, as [`Lights::resolve`] one by one would, when the
+    /// area lights are all rectangles (else each is left to be resolved when first
+    /// needed: a sphere's or a mesh's test gains nothing from lanes).
+    pub fn resolve_run(&self, receiver: &Receiver, drawn: &mut [Option<Toward>]) {
+        if !self.only_rectangles {
+            return;
+        }
+        for run in drawn.chunks_mut(LANES) {
+            // Lanes of no unknown direction keep a (harmless) unit one.
+            let mut directions = [Vec3::Z; LANES];
+            let mut unknown = [false; LANES];
+            for (k, toward) in run.iter().enumerate() {
+                if let Some(toward) = toward
+                    .as_ref()
+                    .filter(|t| matches!(t.source, Source::Unknown))
+                {
+                    (directions[k], unknown[k]) = (toward.direction, true);
+                }
+            }
+            if !unknown.contains(&true) {
+                continue;
+            }
+            let nearest = self.nearest_rectangles(receiver.point, &directions);
+            for ((toward, nearest), _) in run.iter_mut().zip(nearest).zip(unknown).filter(|u| u.1) {
+                let toward = toward.as_mut().expect("an unknown direction is drawn");
+                toward.source = self.source_at(receiver, toward.direction, nearest);
+            }
+        }
+    }
+
+    /// The nearest area light (all rectangles) along each of `directions` from `origin`,
+    /// each light's distances over the lanes at once. A tie goes to the light first in
+    /// order, as in [`Lights::resolve`].
+    fn nearest_rectangles(&self, origin: Vec3, directions: &[Vec3; LANES]) -> [Nearest; LANES] {
+        let mut nearest: [Nearest; LANES] = [None; LANES];
+        for (index, light) in self.area.iter().enumerate() {
+            let rectangle = light.rectangle().expect("the area lights are rectangles");
+            let distances = rectangle.distances_along(origin, directions);
+            for (nearest, &distance) in nearest.iter_mut().zip(&distances) {
+                if distance != f32::INFINITY
+                    && nearest.is_none_or(|(held, _)| distance < held.distance)
+                {
+                    let hit = AreaHit {
+                        distance,
+                        normal: rectangle.normal,
+                        spot: LightSpot::default(),
+                    };
+                    *nearest = Some((hit, index));
+                }
+            }
+        }
+        nearest
+    }
+
+    /// The source of `direction` from `receiver` whose nearest area light is `nearest`.
+    fn source_at(&self, receiver: &Receiver, direction: Vec3, nearest: Nearest) -> Source {
+        match nearest {
+            Some((hit, index)) => {
+                let light = &self.area[index];
+                let density = light.density_at(receiver, direction, hit.distance, hit.normal);
+                let target = receiver.point + direction * hit.distance;
+                let (factor, region) = self.region_factor(receiver, index, direction, Some(target));
+                Source::Area(AreaPoint {
+                    light: index,
+                    target,
+                    radiance: light.emitted(hit.normal, direction, target, hit.spot),
+                    density: self.choice_probability(receiver, index) * density * factor,
+                    region,
+                })
+            }
+            None if self.environment.is_some() => Source::Environment,
+            None => Source::Dark,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::lights::{AreaLight, AreaShape, Emitters, Rectangle, RegionChoice, REGIONS};
+    use ais::rng::Pcg32;
+    use ais::sampling::uniform_sphere;
+
+    /// A rectangle light of shape `shape_index`, corner `corner`, edges `x`, `y`.
+    fn light(corner: Vec3, x: Vec3, y: Vec3, shape_index: u32) -> AreaLight {
+        AreaLight {
+            shape: AreaShape::Rectangle(Rectangle::new(corner, x, y, false).expect("orthogonal")),
+            radiance: Vec3::splat(1.0 + shape_index as f32),
+            texture: None,
+            shape_index,
+        }
+    }
+
+    /// A run's directions resolved together meet what each meets resolved alone, to the
+    /// bit: rectangles in front of one another (the nearer first), one of them with its regions weighed, and
+    /// directions that meet none (drawn over the whole sphere), with empty slots and known
+    /// sources among them.
+    #[test]
+    fn a_run_resolved_together_meets_what_each_meets_alone() {
+        let lights = Lights::new(
+            Emitters {
+                area: vec![
+                    light(Vec3::new(-0.5, -0.5, 1.0), Vec3::X, Vec3::Y, 0),
+                    light(Vec3::new(-1.0, -1.0, 2.0), Vec3::X * 2.0, Vec3::Y * 2.0, 1),
+                    light(Vec3::new(1.0, -1.0, -1.0), Vec3::Y, Vec3::Z * 2.0, 2),
+                ],
+                ..Default::default()
+            },
+            3,
+            10.0,
+        );
+        let weights: [f64; REGIONS] = std::array::from_fn(|r| 0.5 + (r % 3) as f64);
+        let regions = [None, RegionChoice::new(&weights), None];
+        let mut receiver = Receiver::new(Vec3::new(0.1, 0.05, 0.0));
+        receiver.region_choices = &regions;
+        let mut rng = Pcg32::new(3, 1);
+        let mut met = [0; 4];
+        for _ in 0..300 {
+            let mut drawn: Vec<Option<Toward>> = (0..LANES + 5)
+                .map(|k| match k % 7 {
+                    3 => None,
+                    5 => lights.sample_toward(&receiver, [rng.next_f32(), rng.next_f32()]),
+                    _ => Some(Toward::new(uniform_sphere([
+                        rng.next_f32(),
+                        rng.next_f32(),
+                    ]))),
+                })
+                .collect();
+            let mut alone = drawn.clone();
+            lights.resolve_run(&receiver, &mut drawn);
+            for (together, alone) in drawn.iter().zip(&mut alone) {
+                if let Some(alone) = alone {
+                    lights.resolve(&receiver, alone);
+                    met[match alone.source {
+                        Source::Area(point) => point.light,
+                        _ => 3,
+                    }] += 1;
+                }
+                assert_eq!(format!("{together:?}"), format!("{alone:?}"));
+            }
+        }
+        assert!(
+            met.iter().all(|&m| m > 100),
+            "every light and none are met: {met:?}"
+        );
+    }
+}
