@@ -236,7 +236,7 @@ fn run_plain(
         };
         trace_run(run, drawn, &mut arriving, shadow_rays);
         for (toward, &arriving) in drawn.iter_mut().flatten().zip(&arriving) {
-            let value = value_of(run, toward, arriving).value;
+            let value = plain_value_of(run, toward, arriving);
             sum = Value::add(sum, value.to_array());
             if let Some(spread) = spread.as_deref_mut() {
                 spread.add(luminance(value) as f64);
@@ -518,37 +518,53 @@ fn traced_value(
 
 /// What an accepted candidate brings, once its shadow ray is known ([`traced_value`]).
 fn value_of(run: &BatchRun, toward: &mut Toward, shadow_ray: ShadowRay) -> Traced {
-    let at = run.at;
-    let source = run.world.lights.source_of(&at.receiver, toward);
-    let nothing = |free| Traced {
-        value: Vec3::ZERO,
+    let source = run.world.lights.source_of(&run.at.receiver, toward);
+    let (value, parts, free) = match shadow_ray {
+        ShadowRay::Unneeded => (Vec3::ZERO, None, None),
+        ShadowRay::Blocked => (Vec3::ZERO, None, Some(false)),
+        ShadowRay::Free(radiance) => match brought(run, toward, radiance) {
+            Some((value, parts)) => (value, parts, Some(true)),
+            None => (Vec3::ZERO, None, None),
+        },
+    };
+    Traced {
+        value,
         rating: 0.0,
         free,
         source,
-        parts: None,
-    };
-    let radiance = match shadow_ray {
-        ShadowRay::Unneeded => return nothing(None),
-        ShadowRay::Blocked => return nothing(Some(false)),
-        ShadowRay::Free(radiance) => radiance,
-    };
+        parts,
+    }
+}
+
+/// [`value_of`]'s value alone, for AIS off's batches, which record nothing else.
+#[inline]
+fn plain_value_of(run: &BatchRun, toward: &mut Toward, shadow_ray: ShadowRay) -> Vec3 {
+    match shadow_ray {
+        ShadowRay::Free(radiance) => brought(run, toward, radiance).map_or(Vec3::ZERO, |b| b.0),
+        ShadowRay::Unneeded | ShadowRay::Blocked => Vec3::ZERO,
+    }
+}
+
+/// What a candidate whose ray was free brings with `radiance`: f·L/p, and MIS's two
+/// densities where the plain MIS proposal drew it (`None`: nothing, at a zero density,
+/// possible only at a light's rim in f32, or a zero radiance).
+#[inline]
+fn brought(
+    run: &BatchRun,
+    toward: &mut Toward,
+    radiance: Vec3,
+) -> Option<(Vec3, Option<MisParts>)> {
+    let at = run.at;
     // MIS's density from its two parts, kept for the share's moments.
     let parts = run.sampler.mis_parts(at, toward);
     let pdf = match parts {
         Some(parts) => parts.mixed(at.mis_bsdf_share),
         None => run.sampler.pdf(at, toward),
     };
-    // A zero density, possible only at a light's rim in f32, brings nothing.
     if pdf <= 0.0 || radiance == Vec3::ZERO {
-        return nothing(None);
+        return None;
     }
-    Traced {
-        value: at.scattering(toward) * radiance / pdf as f32,
-        rating: 0.0,
-        free: Some(true),
-        source,
-        parts,
-    }
+    Some((at.scattering(toward) * radiance / pdf as f32, parts))
 }
 
 /// Traces an accepted candidate: its contribution f·L/p and what it saw (`last` as in
