@@ -95,7 +95,7 @@ impl Default for EnvironmentDraws {
 
 impl EnvironmentDraws {
     /// Adds the draw for the candidate in `slot` from `u` (the numbers of a
-    /// [`Draw::Environment`]). At most [`RUN`] draws are held.
+    /// [`super::Draw::Environment`]). At most sixteen draws (a run) are held.
     pub fn push(&mut self, slot: usize, u: [f32; 2]) {
         assert!(self.count < RUN, "a run holds at most {RUN} draws");
         self.slots[self.count] = slot;

@@ -51,7 +51,7 @@ impl Default for RectangleDraws {
 
 impl RectangleDraws {
     /// Adds `draw` (of a [`super::Draw::Rectangle`]) for the candidate in `slot`. At most
-    /// [`RUN`] draws are held.
+    /// sixteen draws (a run) are held.
     pub fn push(&mut self, slot: usize, draw: RectangleDraw) {
         assert!(self.count < RUN, "a run holds at most {RUN} draws");
         (self.slots[self.count], self.draws[self.count]) = (slot, Some(draw));

@@ -30,7 +30,7 @@ impl Lights {
     }
 
     /// Finds what each candidate of `drawn` (empty slots passed over) meets first among the
-    /// emitters, where not known yet, as [`Lights::resolve`] one by one would, when the
+    /// emitters, where not known yet, as resolving them one by one would, when the
     /// area lights are all rectangles (else each is left to be resolved when first
     /// needed: a sphere's or a mesh's test gains nothing from lanes).
     pub fn resolve_run(&self, receiver: &Receiver, drawn: &mut [Option<Toward>]) {

@@ -329,7 +329,7 @@ impl GatherLearning {
 
     /// Whether the field has no use in the rest of the render, which then gathers as AIS
     /// off (never with `field_race` false): it lost its race; or, before its verdict, it
-    /// finds little to roll and little to guide ([`GatherLearning::little_use`]).
+    /// finds little to roll and little to guide (its learning's `little_use`).
     pub fn stands_aside(&self) -> bool {
         if !self.may_stand_aside {
             return false;

@@ -63,10 +63,9 @@ impl<'a> CandidateSampler<'a> {
         at.finish(self.begin_direction(at, u))
     }
 
-    /// [`CandidateSampler::sample_direction`], except that a draw from an environment map
-    /// is left to be made together with other candidates' ([`EnvironmentDraws`]).
-    ///
-    /// [`EnvironmentDraws`]: crate::lights::EnvironmentDraws
+    /// [`CandidateSampler::sample_direction`], except that a draw from an environment map,
+    /// a rectangle light or the BSDF is left to be made together with other candidates' of
+    /// its kind ([`CandidateDraw`]).
     #[inline]
     pub fn begin_direction(&self, at: &GatherPoint, u: [f32; 2]) -> CandidateDraw {
         let Some(guide) = self.guide else {

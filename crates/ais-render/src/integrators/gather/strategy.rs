@@ -235,10 +235,9 @@ impl Strategy {
         at.finish(self.begin_direction(at, u))
     }
 
-    /// [`Strategy::sample_direction`], except that a draw from an environment map is left
-    /// to be made together with other candidates' ([`EnvironmentDraws`]).
-    ///
-    /// [`EnvironmentDraws`]: crate::lights::EnvironmentDraws
+    /// [`Strategy::sample_direction`], except that a draw from an environment map, a
+    /// rectangle light or the BSDF is left to be made together with other candidates' of
+    /// its kind ([`CandidateDraw`]).
     #[inline]
     pub fn begin_direction(self, at: &GatherPoint, u: [f32; 2]) -> CandidateDraw {
         match self.effective(at) {
