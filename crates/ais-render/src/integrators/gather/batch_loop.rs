@@ -190,8 +190,9 @@ struct ShadowRays<'a> {
 }
 
 /// Finds what the drawn candidates of a run meet among the lights, together (`drawn`; empty
-/// slots are passed over), traces their shadow rays, then looks up what the free ones bring into `arriving` (from its start, in the
-/// order of the filled slots): all the lookups after all the rays, so that they overlap.
+/// slots are passed over), traces their shadow rays, then looks up what the free ones bring
+/// into `arriving` (from its start, in the order of the filled slots): all the lookups
+/// after all the rays, so that they overlap.
 fn trace_run(
     run: &BatchRun,
     drawn: &mut [Option<Toward>],
