@@ -8,14 +8,12 @@
 //! are independent and the core overlaps them. The directions, and so the images, are the
 //! same to the bit as one draw at a time ([`super::Lights::sample_toward`]).
 
+use super::draw::{HeldDraws, RUN};
 use super::environment::CellPoint;
 use super::environment_guide::Pick;
 #[cfg(test)]
 use super::Draw;
 use super::{Environment, EnvironmentGuide, EnvironmentMap, Lights, Receiver, Toward, ONE_BELOW};
-
-/// The most draws a run holds.
-pub const RUN: usize = 16;
 
 /// Where one environment draw stands between steps.
 #[derive(Clone, Copy, Debug)]
@@ -76,31 +74,17 @@ impl Step {
 }
 
 /// Environment draws of a run of candidates, each to be put in its candidate's slot.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 pub struct EnvironmentDraws {
-    slots: [usize; RUN],
-    numbers: [[f32; 2]; RUN],
-    count: usize,
-}
-
-impl Default for EnvironmentDraws {
-    fn default() -> Self {
-        EnvironmentDraws {
-            slots: [0; RUN],
-            numbers: [[0.0; 2]; RUN],
-            count: 0,
-        }
-    }
+    /// Each draw's numbers.
+    held: HeldDraws<[f32; 2]>,
 }
 
 impl EnvironmentDraws {
     /// Adds the draw for the candidate in `slot` from `u` (the numbers of a
     /// [`super::Draw::Environment`]). At most sixteen draws (a run) are held.
     pub fn push(&mut self, slot: usize, u: [f32; 2]) {
-        assert!(self.count < RUN, "a run holds at most {RUN} draws");
-        self.slots[self.count] = slot;
-        self.numbers[self.count] = u;
-        self.count += 1;
+        self.held.push(slot, u);
     }
 
     /// Makes every draw held for `receiver` (by its guide when it has one) and gives each
@@ -111,13 +95,13 @@ impl EnvironmentDraws {
         receiver: &Receiver,
         mut put: impl FnMut(usize, Toward),
     ) {
-        let count = std::mem::take(&mut self.count);
+        let (slots, numbers) = self.held.take();
         let guide = receiver.environment_guide;
         let map = match &lights.environment {
             Some(Environment::Map(map)) if guide.is_none_or(|g| g.partition().holds_cells()) => map,
             _ => {
                 // Nothing to overlap: one draw at a time.
-                for (&slot, &u) in self.slots[..count].iter().zip(&self.numbers) {
+                for (&slot, &u) in slots.iter().zip(numbers.iter()) {
                     if let Some(toward) = lights.environment_toward(receiver, u) {
                         put(slot, toward);
                     }
@@ -130,7 +114,8 @@ impl EnvironmentDraws {
             fy: 0.0,
             u: 0.0,
         }; RUN];
-        for (step, &u) in steps.iter_mut().zip(&self.numbers[..count]) {
+        let count = numbers.len();
+        for (step, &u) in steps.iter_mut().zip(numbers.iter()) {
             *step = Step::first(map, guide, u);
         }
         for step in &mut steps[..count] {
@@ -142,9 +127,9 @@ impl EnvironmentDraws {
             column: 0,
             within: [0.0; 2],
         }; RUN];
-        let mut slots = [0; RUN];
+        let mut cell_slots = [0; RUN];
         let mut cells = 0;
-        for (step, &slot) in steps[..count].iter().zip(&self.slots) {
+        for (step, &slot) in steps[..count].iter().zip(slots) {
             if let Step::Cell {
                 row,
                 column,
@@ -156,11 +141,11 @@ impl EnvironmentDraws {
                     column,
                     within,
                 };
-                slots[cells] = slot;
+                cell_slots[cells] = slot;
                 cells += 1;
             }
         }
-        map.towards_at(&points[..cells], |k, toward| put(slots[k], toward));
+        map.towards_at(&points[..cells], |k, toward| put(cell_slots[k], toward));
     }
 }
 

@@ -6,7 +6,7 @@
 //! ([`super::Lights::sample_toward`]).
 
 use super::area::AreaSample;
-use super::environment_draws::RUN;
+use super::draw::{HeldDraws, RUN};
 use super::{LightSpot, Lights, Receiver, Rectangle, Toward};
 
 /// An area light chosen by light sampling, and what weighs the points drawn from it.
@@ -32,30 +32,17 @@ pub struct RectangleDraw {
 }
 
 /// Rectangle-light draws of a run of candidates, each to be put in its candidate's slot.
-#[derive(Debug)]
+#[derive(Debug, Default)]
 pub struct RectangleDraws {
-    slots: [usize; RUN],
-    draws: [Option<RectangleDraw>; RUN],
-    count: usize,
-}
-
-impl Default for RectangleDraws {
-    fn default() -> Self {
-        RectangleDraws {
-            slots: [0; RUN],
-            draws: [None; RUN],
-            count: 0,
-        }
-    }
+    /// Each draw (`None` once taken to be made).
+    held: HeldDraws<Option<RectangleDraw>>,
 }
 
 impl RectangleDraws {
     /// Adds `draw` (of a [`super::Draw::Rectangle`]) for the candidate in `slot`. At most
     /// sixteen draws (a run) are held.
     pub fn push(&mut self, slot: usize, draw: RectangleDraw) {
-        assert!(self.count < RUN, "a run holds at most {RUN} draws");
-        (self.slots[self.count], self.draws[self.count]) = (slot, Some(draw));
-        self.count += 1;
+        self.held.push(slot, Some(draw));
     }
 
     /// Makes every draw held for `receiver`, light by light, and gives each direction to
@@ -67,14 +54,14 @@ impl RectangleDraws {
         receiver: &Receiver,
         mut put: impl FnMut(usize, Toward),
     ) {
-        let count = std::mem::take(&mut self.count);
+        let (slots, draws) = self.held.take();
         // Each pass takes the draws of the first light left.
-        while let Some(first) = self.draws[..count].iter().flatten().next() {
+        while let Some(first) = draws.iter().flatten().next() {
             let light = first.choice.light;
             let mut squares = [[0.0; 2]; RUN];
             let mut taken = [(0, first.choice); RUN];
             let mut n = 0;
-            for (&slot, held) in self.slots[..count].iter().zip(&mut self.draws) {
+            for (&slot, held) in slots.iter().zip(draws.iter_mut()) {
                 if let Some(draw) = held.take_if(|draw| draw.choice.light == light) {
                     (squares[n], taken[n]) = (draw.square, (slot, draw.choice));
                     n += 1;
