@@ -57,6 +57,26 @@ pub struct AreaSample {
     pub spot: LightSpot,
 }
 
+impl AreaSample {
+    /// The sample of a point of `rectangle` drawn along `direction` with density `pdf`, at
+    /// `distance`.
+    #[inline]
+    pub(super) fn on_rectangle(
+        rectangle: &Rectangle,
+        direction: Vec3,
+        pdf: f64,
+        distance: f32,
+    ) -> Self {
+        AreaSample {
+            direction,
+            pdf,
+            distance,
+            normal: rectangle.normal,
+            spot: LightSpot::default(),
+        }
+    }
+}
+
 /// Where on a mesh light a point lies (unused by spheres and rectangles, whose texture
 /// coordinates follow from the point).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -243,13 +263,9 @@ impl AreaLight {
             AreaShape::Rectangle(rectangle) => {
                 let (direction, pdf, distance) = receiver
                     .with_rectangle_view(rectangle, |view| Rectangle::sample_view(view, u))?;
-                Some(AreaSample {
-                    direction,
-                    pdf,
-                    distance,
-                    normal: rectangle.normal,
-                    spot: LightSpot::default(),
-                })
+                Some(AreaSample::on_rectangle(
+                    rectangle, direction, pdf, distance,
+                ))
             }
             AreaShape::Quadric { quadric, flipped } => {
                 let drawn = quadric.sample(u);

@@ -7,7 +7,7 @@
 
 use super::area::AreaSample;
 use super::draw::{HeldDraws, RUN};
-use super::{LightSpot, Lights, Receiver, Rectangle, Toward};
+use super::{Lights, Receiver, Rectangle, Toward};
 
 /// An area light chosen by light sampling, and what weighs the points drawn from it.
 #[derive(Clone, Copy, Debug)]
@@ -74,13 +74,7 @@ impl RectangleDraws {
                 continue;
             };
             Rectangle::sample_view_run(&view, &squares[..n], |k, direction, pdf, distance| {
-                let sample = AreaSample {
-                    direction,
-                    pdf,
-                    distance,
-                    normal: rectangle.normal,
-                    spot: LightSpot::default(),
-                };
+                let sample = AreaSample::on_rectangle(rectangle, direction, pdf, distance);
                 let (slot, choice) = taken[k];
                 put(slot, lights.area_toward(receiver, choice, &sample));
             });
