@@ -2,7 +2,7 @@
 
 use ais::rng::Pcg32;
 use ais_render::geometry::{
-    spawn_ray, Geometry, LastBlocker, Ray, ShapeGeometry, ShapeInput, Sphere, Triangle,
+    spawn_ray, Geometry, Ray, RecentBlockers, ShapeGeometry, ShapeInput, Sphere, Triangle,
 };
 use ais_render::mesh::TriangleMesh;
 use ais_render::shapes;
@@ -178,8 +178,8 @@ fn rays_from_one_origin_are_answered_alike_after_a_blocker() {
     let mut blocked = 0;
     for origin in 0..400 {
         let origin_point = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0;
-        // One gather's rays: one origin, one remembered blocker.
-        let mut last = LastBlocker::default();
+        // One gather's rays: one origin, its remembered blockers.
+        let mut blockers = RecentBlockers::default();
         for i in 0..16 {
             let mut ray = Ray::new(origin_point, random_unit(&mut rng));
             if i % 3 == 0 {
@@ -187,7 +187,7 @@ fn rays_from_one_origin_are_answered_alike_after_a_blocker() {
             }
             let expected = geometry.intersect_brute_force(&ray).is_some();
             assert_eq!(
-                geometry.occluded_after(&ray, &mut last),
+                geometry.occluded_after(&ray, &mut blockers),
                 expected,
                 "origin {origin}, ray {i}"
             );

@@ -81,6 +81,21 @@ impl LanedBvh {
         }
     }
 
+    /// Whether [`LanedBvh::near_blocks`] makes the same test for primitives `a` and `b`: the
+    /// same run of eight triangles, or the same other primitive.
+    pub(super) fn same_near_test(&self, a: usize, b: usize) -> bool {
+        if self.is_triangle(a) && self.is_triangle(b) {
+            a / 8 == b / 8
+        } else {
+            a == b
+        }
+    }
+
+    /// Whether primitive `index` is a triangle (in the lanes).
+    fn is_triangle(&self, index: usize) -> bool {
+        self.lanes.others(index as u32, 1) == 0
+    }
+
     /// The nearest primitive along `ray` before its end. `hit(index, t_max)` answers for the
     /// primitives that are not triangles.
     pub(super) fn nearest(

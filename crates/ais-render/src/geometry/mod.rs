@@ -10,6 +10,7 @@ mod instances;
 mod primitive;
 mod quadric;
 mod ray;
+mod recent_blockers;
 mod triangle_lanes;
 
 pub use basis::basis;
@@ -19,6 +20,7 @@ use primitive::Packed;
 pub use primitive::{Primitive, Sphere, Triangle};
 pub use quadric::{Quadric, QuadricKind, QuadricSample, QuadricSurface};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
+pub use recent_blockers::RecentBlockers;
 
 use crate::mesh::{AttributeSite, MeshAttribute, TriangleMesh};
 use cwbvh_traversal::LanedBvh;
@@ -123,15 +125,6 @@ enum Accelerator {
     /// Intel Embree 3.
     #[cfg(feature = "embree")]
     Embree(embree::EmbreeScene),
-}
-
-/// What blocked the last blocked ray of a run of rays that share an origin (a gather's), for
-/// [`Geometry::occluded_after`] to try first. Start a new one for each origin: it only
-/// saves time, and a fresh one per gather keeps the work independent of the thread count.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct LastBlocker {
-    /// The blocking primitive, in the accelerator's order.
-    index: Option<usize>,
 }
 
 /// Where a primitive came from: what shading a hit on it needs.
@@ -500,33 +493,36 @@ impl Geometry {
 
     /// Whether anything blocks the ray before `t_max` (any-hit query).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        self.occluded_after(ray, &mut LastBlocker::default())
+        self.occluded_after(ray, &mut RecentBlockers::default())
     }
 
     /// Whether anything blocks the ray before `t_max`, trying first near what blocked the
-    /// ray before it (`last`, which then remembers this ray's blocker). The rays of one
-    /// gather share an origin, and the blocked ones mostly meet the same few surfaces (a
-    /// wall, a ceiling): a test of eight triangles then stands in for a traversal. The
+    /// rays before it (`blockers`, which then remembers this ray's blocker). The rays of
+    /// one gather share an origin, and the blocked ones mostly meet the same few surfaces
+    /// (a wall, a ceiling): a test of eight triangles then stands in for a traversal. The
     /// answer is [`Geometry::occluded`]'s, but for a ray that grazes the edge of a box of
     /// the BVH within float rounding (a traversal might pass by a triangle that the test of
     /// its run hits).
-    pub fn occluded_after(&self, ray: &Ray, last: &mut LastBlocker) -> bool {
+    pub fn occluded_after(&self, ray: &Ray, blockers: &mut RecentBlockers) -> bool {
         match &self.accelerator {
             None => false,
             Some(Accelerator::Cwbvh(bvh)) => {
                 let blocks = |index, t_max| self.blocking_distance(index, ray, t_max) < t_max;
-                if let Some(index) = last.index {
-                    if bvh.near_blocks(index, ray, blocks) {
+                let tried = blockers.how_many_to_try();
+                for at in 0..tried {
+                    if bvh.near_blocks(blockers.recent[at] as usize, ray, blocks) {
+                        blockers.blocked_by(at);
                         return true;
                     }
                 }
+                blockers.missed(tried);
                 let blocker = bvh.blocker(ray, blocks);
-                if blocker.is_some() {
-                    last.index = blocker;
+                if let Some(index) = blocker {
+                    blockers.remember(index, |a, b| bvh.same_near_test(a, b));
                 }
                 blocker.is_some()
             }
-            // Embree answers from its own traversal; `last` stays as it was.
+            // Embree answers from its own traversal; `blockers` stay as they were.
             #[cfg(feature = "embree")]
             Some(Accelerator::Embree(scene)) => scene.occluded(ray),
         }

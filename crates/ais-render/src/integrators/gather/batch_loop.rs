@@ -8,7 +8,7 @@ use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, Shadow
 use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
 use super::strategy::{CandidateDraw, GatherPoint, MisParts};
-use crate::geometry::LastBlocker;
+use crate::geometry::RecentBlockers;
 use crate::lights::{luminance, EnvironmentDraws, RectangleDraws, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
@@ -164,7 +164,7 @@ fn run_ahead(
     let mut drawn = [None; AHEAD];
     let mut weights = [1.0; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
-    let mut last_blocker = LastBlocker::default();
+    let mut blockers = RecentBlockers::default();
     loop {
         let count = draw_ahead(run, batch, &mut drawn, &mut weights);
         if count == 0 {
@@ -172,7 +172,7 @@ fn run_ahead(
         }
         let shadow_rays = ShadowRays {
             counts,
-            last_blocker: &mut last_blocker,
+            blockers: &mut blockers,
         };
         trace_run(run, &mut drawn[..count], &mut arriving, shadow_rays);
         let traced = drawn[..count].iter_mut().flatten().zip(&arriving);
@@ -186,7 +186,7 @@ fn run_ahead(
 /// Where a gather's shadow rays are counted, and the blocker they try first.
 struct ShadowRays<'a> {
     counts: &'a mut RayCounts,
-    last_blocker: &'a mut LastBlocker,
+    blockers: &'a mut RecentBlockers,
 }
 
 /// Finds what the drawn candidates of a run meet among the lights, together (`drawn`; empty
@@ -202,7 +202,7 @@ fn trace_run(
     run.world.lights.resolve_run(&run.at.receiver, drawn);
     let mut blocked = [None; AHEAD];
     for (toward, blocked) in drawn.iter_mut().flatten().zip(&mut blocked) {
-        *blocked = trace_aimed(run.world, run.at, toward, rays.counts, rays.last_blocker);
+        *blocked = trace_aimed(run.world, run.at, toward, rays.counts, rays.blockers);
     }
     let looked_up = drawn.iter_mut().flatten().zip(&blocked);
     for ((toward, blocked), arriving) in looked_up.zip(arriving) {
@@ -224,7 +224,7 @@ fn run_plain(
     let mut tally = PlainTally::default();
     let mut drawn = [None; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
-    let mut last_blocker = LastBlocker::default();
+    let mut blockers = RecentBlockers::default();
     for numbers in batch.begin_plain(run.rays, run.seed).chunks(AHEAD) {
         let drawn = &mut drawn[..numbers.len()];
         draw_into(run, numbers, drawn);
@@ -233,7 +233,7 @@ fn run_plain(
         tally.traced += kept as u32;
         let shadow_rays = ShadowRays {
             counts,
-            last_blocker: &mut last_blocker,
+            blockers: &mut blockers,
         };
         trace_run(run, drawn, &mut arriving, shadow_rays);
         for (toward, &arriving) in drawn.iter_mut().flatten().zip(&arriving) {
@@ -361,7 +361,7 @@ fn run_one_by_one<P: BatchProbe>(
     let at = run.at;
     let value_only = batch.map().is_none() && batch.observations().is_none();
     let mut values = RunningMean::default();
-    let mut last_blocker = LastBlocker::default();
+    let mut blockers = RecentBlockers::default();
     while let Some(candidate) = batch.next_candidate() {
         let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
             probe.decided(at.frame.normal, false);
@@ -374,9 +374,9 @@ fn run_one_by_one<P: BatchProbe>(
         if let Decision::Trace { weight } = decision {
             let started = run.clock.map(|_| Instant::now());
             let traced = if value_only && known.is_none() {
-                traced_value(run, toward, counts, &mut last_blocker)
+                traced_value(run, toward, counts, &mut blockers)
             } else {
-                trace(run, toward, known, counts, &mut last_blocker)
+                trace(run, toward, known, counts, &mut blockers)
             };
             record(run, batch, lessons, &mut toward, &traced, weight);
             if let (Some(clock), Some(started)) = (run.clock, started) {
@@ -505,15 +505,15 @@ struct Traced {
 /// Traces an accepted candidate whose value alone is wanted (with whether its ray was
 /// free, for a recorder): the density, the BSDF and the environment's radiance are looked
 /// up only if its shadow ray is free. The same value as [`trace`] gives; the rating is 0,
-/// as nothing reads it (the batch has no map to learn). `last` remembers the gather's last
-/// blocker ([`LastBlocker`]).
+/// as nothing reads it (the batch has no map to learn). `blockers` remembers what
+/// blocked the gather's rays ([`RecentBlockers`]).
 fn traced_value(
     run: &BatchRun,
     mut toward: Toward,
     counts: &mut RayCounts,
-    last: &mut LastBlocker,
+    blockers: &mut RecentBlockers,
 ) -> Traced {
-    let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts, last);
+    let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts, blockers);
     value_of(run, &mut toward, shadow_ray)
 }
 
@@ -568,14 +568,14 @@ fn brought(
     Some((at.scattering(toward) * radiance / pdf as f32, parts))
 }
 
-/// Traces an accepted candidate: its contribution f·L/p and what it saw (`last` as in
-/// [`traced_value`]).
+/// Traces an accepted candidate: its contribution f·L/p and what it saw (`blockers` as
+/// in [`traced_value`]).
 fn trace(
     run: &BatchRun,
     mut toward: Toward,
     known: Option<Known>,
     counts: &mut RayCounts,
-    last: &mut LastBlocker,
+    blockers: &mut RecentBlockers,
 ) -> Traced {
     let at = run.at;
     let Known {
@@ -595,7 +595,7 @@ fn trace(
             parts: None,
         };
     }
-    let actual = leaving.trace(run.world, counts, last);
+    let actual = leaving.trace(run.world, counts, blockers);
     let rating = rating(luminance(actual), luminance(leaving.unoccluded));
     Traced {
         value: at.scattering(&toward) * actual / pdf as f32,

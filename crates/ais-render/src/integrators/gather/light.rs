@@ -2,7 +2,7 @@
 //! nothing in the way, and what the occlusion ray lets through.
 
 use super::strategy::GatherPoint;
-use crate::geometry::{spawn_ray, spawn_ray_to, LastBlocker, Ray};
+use crate::geometry::{spawn_ray, spawn_ray_to, Ray, RecentBlockers};
 use crate::lights::{Aim, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
@@ -28,16 +28,21 @@ impl Leaving {
     }
 
     /// What the ray actually brings: its unoccluded radiance, or zero if blocked, tried
-    /// first near what blocked the gather's last blocked ray (`last`). Only rays that could
+    /// first near what blocked the gather's earlier rays (`blockers`). Only rays that could
     /// bring light are traced (and counted).
-    pub fn trace(self, world: &World, counts: &mut RayCounts, last: &mut LastBlocker) -> Vec3 {
+    pub fn trace(
+        self,
+        world: &World,
+        counts: &mut RayCounts,
+        blockers: &mut RecentBlockers,
+    ) -> Vec3 {
         // A ray whose unoccluded radiance is zero brings zero whatever blocks it.
         if self.unoccluded == Vec3::ZERO {
             return Vec3::ZERO;
         }
         let ray = self.ray;
         counts.occlusion += 1;
-        if world.geometry.occluded_after(&ray, last) {
+        if world.geometry.occluded_after(&ray, blockers) {
             Vec3::ZERO
         } else {
             self.unoccluded
@@ -71,21 +76,21 @@ pub enum ShadowRay {
 /// The radiance a candidate brings if its shadow ray is free. The ray is traced before the
 /// radiance is looked up (for the environment, a texture lookup), which a blocked ray does
 /// not need; so a ray toward a black part of the environment is traced (and counted),
-/// where [`Leaving`] would know not to. `last` as in [`trace_aimed`].
+/// where [`Leaving`] would know not to. `blockers` as in [`trace_aimed`].
 pub fn free_radiance(
     world: &World,
     at: &GatherPoint,
     toward: &mut Toward,
     counts: &mut RayCounts,
-    last: &mut LastBlocker,
+    blockers: &mut RecentBlockers,
 ) -> ShadowRay {
-    let blocked = trace_aimed(world, at, toward, counts, last);
+    let blocked = trace_aimed(world, at, toward, counts, blockers);
     radiance_if_free(world, at, toward, blocked)
 }
 
 /// Whether the shadow ray of `toward` is blocked (`None`: no ray was needed, the candidate
-/// surely brings nothing), tried first near what blocked the gather's last blocked ray
-/// (`last`). The first half of [`free_radiance`], for gathers that trace several
+/// surely brings nothing), tried first near what blocked the gather's earlier rays
+/// (`blockers`). The first half of [`free_radiance`], for gathers that trace several
 /// candidates' rays before looking up what the free ones bring.
 #[inline]
 pub fn trace_aimed(
@@ -93,7 +98,7 @@ pub fn trace_aimed(
     at: &GatherPoint,
     toward: &mut Toward,
     counts: &mut RayCounts,
-    last: &mut LastBlocker,
+    blockers: &mut RecentBlockers,
 ) -> Option<bool> {
     let target = match world.lights.aim(&at.receiver, toward) {
         Aim::Nothing => return None,
@@ -102,7 +107,7 @@ pub fn trace_aimed(
     };
     counts.occlusion += 1;
     let ray = shadow_ray(at, toward.direction, target);
-    Some(world.geometry.occluded_after(&ray, last))
+    Some(world.geometry.occluded_after(&ray, blockers))
 }
 
 /// The second half of [`free_radiance`]: what `toward` (aimed by [`trace_aimed`]) brings,
@@ -129,5 +134,5 @@ pub fn arriving_light(
     toward: &mut Toward,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    Leaving::new(world, at, toward).trace(world, counts, &mut LastBlocker::default())
+    Leaving::new(world, at, toward).trace(world, counts, &mut RecentBlockers::default())
 }
