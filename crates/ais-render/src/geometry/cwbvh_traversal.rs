@@ -81,13 +81,13 @@ impl LanedBvh {
         }
     }
 
-    /// Whether [`LanedBvh::near_blocks`] makes the same test for primitives `a` and `b`: the
-    /// same run of eight triangles, or the same other primitive.
-    pub(super) fn same_near_test(&self, a: usize, b: usize) -> bool {
-        if self.is_triangle(a) && self.is_triangle(b) {
-            a / 8 == b / 8
+    /// What names the test [`LanedBvh::near_blocks`] makes for primitive `index`: its run
+    /// of eight for a triangle, the primitive itself otherwise (the high bit set).
+    pub(super) fn near_test(&self, index: usize) -> u32 {
+        if self.is_triangle(index) {
+            (index / 8) as u32
         } else {
-            a == b
+            index as u32 | 1 << 31
         }
     }
 

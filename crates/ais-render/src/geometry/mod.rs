@@ -510,7 +510,7 @@ impl Geometry {
                 let blocks = |index, t_max| self.blocking_distance(index, ray, t_max) < t_max;
                 let tried = blockers.how_many_to_try();
                 for at in 0..tried {
-                    if bvh.near_blocks(blockers.recent[at] as usize, ray, blocks) {
+                    if bvh.near_blocks(blockers.index(at), ray, blocks) {
                         blockers.blocked_by(at);
                         return true;
                     }
@@ -518,7 +518,7 @@ impl Geometry {
                 blockers.missed(tried);
                 let blocker = bvh.blocker(ray, blocks);
                 if let Some(index) = blocker {
-                    blockers.remember(index, |a, b| bvh.same_near_test(a, b));
+                    blockers.remember(index, bvh.near_test(index));
                 }
                 blocker.is_some()
             }

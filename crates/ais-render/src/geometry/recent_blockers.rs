@@ -7,28 +7,39 @@
 /// thread count.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RecentBlockers {
-    /// Blocking primitives in the accelerator's order, the most recently useful first, no
-    /// two in the same run of eight triangles.
-    pub(super) recent: [u32; RECENT_BLOCKERS],
+    /// Blocking primitives, the most recently useful first, no two that make the same test.
+    recent: [Blocker; RECENT_BLOCKERS],
     /// How many of `recent` are filled.
     len: usize,
-    /// Rays blocked by a primitive of `recent` past the first, and rays that tried those
-    /// and found none blocking: the past-the-first are tried only while they pay.
+    /// Tests of the blockers past the first, and how many of them found the ray blocked:
+    /// those are tried only while they pay.
+    later_tests: u32,
     later_hits: u32,
-    later_misses: u32,
+}
+
+/// A primitive that blocked a ray.
+#[derive(Clone, Copy, Debug, Default)]
+struct Blocker {
+    /// The primitive, in the accelerator's order.
+    index: u32,
+    /// What names its test: the same for two primitives tested together.
+    test: u32,
 }
 
 /// How many blockers a gather remembers.
 const RECENT_BLOCKERS: usize = 8;
 
+/// How many tests past the first a gather makes before it asks whether they pay.
+const FREE_TESTS: u32 = 8;
+
 impl RecentBlockers {
     /// How many of the blockers the next ray tries: the first always, the rest while about
-    /// one ray in five that tries them is blocked by one. A run's test takes roughly a
-    /// fifth of a blocked ray's traversal (about 12 against 60 ns in the rooms' profiles),
-    /// so below that rate the tries cost more than they save, as in foliage, where a
-    /// blocking leaf rarely blocks another ray. The first few tries are free of the rule.
+    /// one of their tests in five finds a ray blocked. A run's test takes roughly a fifth
+    /// of a blocked ray's traversal (about 12 against 60 ns in the rooms' profiles), so
+    /// below that rate the tests cost more than they save, as in foliage, where a blocking
+    /// leaf rarely blocks another ray. The first tests are free of the rule.
     pub(super) fn how_many_to_try(&self) -> usize {
-        if self.later_misses <= 4 * self.later_hits + 4 {
+        if self.later_tests <= 10 * self.later_hits + FREE_TESTS {
             self.len
         } else {
             self.len.min(1)
@@ -38,6 +49,7 @@ impl RecentBlockers {
     /// `recent[at]` blocked the ray: it moves to the front.
     pub(super) fn blocked_by(&mut self, at: usize) {
         if at > 0 {
+            self.later_tests += at as u32;
             self.later_hits += 1;
         }
         self.recent[..=at].rotate_right(1);
@@ -45,22 +57,27 @@ impl RecentBlockers {
 
     /// None of the first `tried` blocked the ray.
     pub(super) fn missed(&mut self, tried: usize) {
-        if tried > 1 {
-            self.later_misses += 1;
-        }
+        self.later_tests += tried.saturating_sub(1) as u32;
     }
 
-    /// A blocker found by traversal, put at the front (in the place of one that makes the
-    /// same test); the oldest drops out when all places are taken.
-    pub(super) fn remember(&mut self, index: usize, same_test: impl Fn(usize, usize) -> bool) {
-        let known = self.recent[..self.len]
-            .iter()
-            .position(|&k| same_test(k as usize, index));
+    /// The `at`-th blocker to try (the primitive, in the accelerator's order).
+    pub(super) fn index(&self, at: usize) -> usize {
+        self.recent[at].index as usize
+    }
+
+    /// A blocker found by traversal, with what names its test (the same for primitives
+    /// tested together), put at the front in the place of one that makes the same test;
+    /// the oldest drops out when all places are taken.
+    pub(super) fn remember(&mut self, index: usize, test: u32) {
+        let known = self.recent[..self.len].iter().position(|k| k.test == test);
         let at = known.unwrap_or_else(|| {
             self.len = (self.len + 1).min(RECENT_BLOCKERS);
             self.len - 1
         });
-        self.recent[at] = index as u32;
+        self.recent[at] = Blocker {
+            index: index as u32,
+            test,
+        };
         self.recent[..=at].rotate_right(1);
     }
 }
@@ -69,50 +86,62 @@ impl RecentBlockers {
 mod tests {
     use super::*;
 
-    /// Same test: the same run of eight.
-    fn same_run(a: usize, b: usize) -> bool {
-        a / 8 == b / 8
+    /// Remembers triangle `index`, tested with its run of eight.
+    fn remember(blockers: &mut RecentBlockers, index: usize) {
+        blockers.remember(index, (index / 8) as u32);
     }
 
     #[test]
     fn the_most_recently_useful_blocker_comes_first_and_the_oldest_drops_out() {
         let mut blockers = RecentBlockers::default();
         for index in 0..RECENT_BLOCKERS + 1 {
-            blockers.remember(index * 8, same_run);
+            remember(&mut blockers, index * 8);
         }
         assert_eq!(blockers.len, RECENT_BLOCKERS);
-        assert_eq!(blockers.recent[0], (RECENT_BLOCKERS * 8) as u32);
-        assert!(!blockers.recent.contains(&0), "the oldest is gone");
+        assert_eq!(blockers.index(0), RECENT_BLOCKERS * 8);
+        assert!(
+            (0..RECENT_BLOCKERS).all(|at| blockers.index(at) != 0),
+            "the oldest is gone"
+        );
         // A primitive of a run already there takes that run's place, at the front.
-        blockers.remember(8 * 3 + 5, same_run);
+        remember(&mut blockers, 8 * 3 + 5);
         assert_eq!(blockers.len, RECENT_BLOCKERS);
-        assert_eq!(blockers.recent[0], 8 * 3 + 5);
-        assert_eq!(blockers.recent.iter().filter(|&&k| k / 8 == 3).count(), 1);
+        assert_eq!(blockers.index(0), 8 * 3 + 5);
+        let of_run_3 = (0..RECENT_BLOCKERS).filter(|&at| blockers.index(at) / 8 == 3);
+        assert_eq!(of_run_3.count(), 1);
         // One that blocks again moves to the front.
-        let second = blockers.recent[1];
+        let second = blockers.index(1);
         blockers.blocked_by(1);
-        assert_eq!(blockers.recent[0], second);
+        assert_eq!(blockers.index(0), second);
     }
 
     #[test]
-    fn blockers_past_the_first_are_tried_while_about_one_try_in_five_pays() {
+    fn blockers_past_the_first_are_tried_while_about_one_test_in_ten_pays() {
         let mut blockers = RecentBlockers::default();
-        blockers.remember(0, same_run);
+        remember(&mut blockers, 0);
         assert_eq!(blockers.how_many_to_try(), 1);
-        blockers.remember(8, same_run);
-        assert_eq!(blockers.how_many_to_try(), 2);
-        // Five misses in a row without a hit: only the first is tried from then on.
-        for _ in 0..4 {
-            blockers.missed(2);
-            assert_eq!(blockers.how_many_to_try(), 2);
+        remember(&mut blockers, 8);
+        remember(&mut blockers, 16);
+        assert_eq!(blockers.how_many_to_try(), 3);
+        // The free tests past the first find nothing; the next one stops them.
+        for _ in 0..FREE_TESTS / 2 {
+            assert_eq!(blockers.how_many_to_try(), 3);
+            blockers.missed(3);
         }
+        assert_eq!(blockers.later_tests, FREE_TESTS);
+        assert_eq!(blockers.how_many_to_try(), 3);
         blockers.missed(2);
         assert_eq!(blockers.how_many_to_try(), 1);
-        // A miss of the first alone says nothing of the others.
+        // A miss of the first alone tests none of the others.
         blockers.missed(1);
-        assert_eq!(blockers.later_misses, 5);
-        // A hit past the first allows four more misses.
-        blockers.blocked_by(1);
-        assert_eq!(blockers.how_many_to_try(), 2);
+        assert_eq!(blockers.later_tests, FREE_TESTS + 1);
+        // A hit at the third place (two tests past the first) allows ten tests more.
+        blockers.blocked_by(2);
+        assert_eq!(blockers.later_tests, FREE_TESTS + 3);
+        for _ in 0..4 {
+            assert_eq!(blockers.how_many_to_try(), 3);
+            blockers.missed(3);
+        }
+        assert_eq!(blockers.how_many_to_try(), 1);
     }
 }
