@@ -1,10 +1,10 @@
 //! What blocked a gather's earlier shadow rays, tried before a traversal.
 
 /// The primitives that blocked a gather's rays (rays that share an origin), for
-/// [`super::Geometry::occluded_after`] to try before a traversal: the blocked rays of a gather in a
-/// room mostly meet the same few surfaces (walls, a ceiling). Start a new one for each
-/// origin: it only saves time, and a fresh one per gather keeps the work independent of the
-/// thread count.
+/// [`super::Geometry::occluded_after`] to try before a traversal: the blocked rays of a
+/// gather in a room mostly meet the same few surfaces (walls, a ceiling). Start a new one
+/// for each origin: it only saves time, and a fresh one per gather keeps the work
+/// independent of the thread count.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RecentBlockers {
     /// Blocking primitives, the most recently useful first, no two that make the same test.

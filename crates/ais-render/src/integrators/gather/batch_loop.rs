@@ -183,7 +183,7 @@ fn run_ahead(
     }
 }
 
-/// Where a gather's shadow rays are counted, and the blocker they try first.
+/// Where a gather's shadow rays are counted, and the blockers they try first.
 struct ShadowRays<'a> {
     counts: &'a mut RayCounts,
     blockers: &'a mut RecentBlockers,
