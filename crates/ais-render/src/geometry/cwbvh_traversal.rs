@@ -74,10 +74,10 @@ impl LanedBvh {
         ray: &Ray,
         blocks: impl FnOnce(usize, f32) -> bool,
     ) -> bool {
-        if self.lanes.others(index as u32, 1) != 0 {
-            blocks(index, ray.t_max)
-        } else {
+        if self.is_triangle(index) {
             self.lanes.run_blocks(index, ray, ray.t_max)
+        } else {
+            blocks(index, ray.t_max)
         }
     }
 
