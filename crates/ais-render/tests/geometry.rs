@@ -2,7 +2,8 @@
 
 use ais::rng::Pcg32;
 use ais_render::geometry::{
-    spawn_ray, Geometry, Ray, RecentBlockers, ShapeGeometry, ShapeInput, Sphere, Triangle,
+    offset_origin, spawn_ray, spawn_ray_to, Geometry, LeavingSurface, Ray, RecentBlockers, Shaft,
+    ShapeGeometry, ShapeInput, Sphere, Triangle,
 };
 use ais_render::mesh::TriangleMesh;
 use ais_render::shapes;
@@ -198,6 +199,145 @@ fn rays_from_one_origin_are_answered_alike_after_a_blocker() {
         blocked > 2000,
         "the test must exercise blocked rays: {blocked}"
     );
+}
+
+/// A shape of one mesh from `positions`, three per triangle.
+fn triangles_shape(positions: Vec<Vec3>) -> ShapeInput {
+    let triangles = (0..positions.len() as u32 / 3)
+        .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+        .collect();
+    let mesh = TriangleMesh {
+        positions,
+        triangles,
+        ..TriangleMesh::default()
+    };
+    ShapeInput {
+        geometry: ShapeGeometry::Mesh(mesh),
+        flip_normals: false,
+        rotation: None,
+    }
+}
+
+/// The shafts' scene: a floor (shape 0) under small triangles (shape 1) and spheres
+/// (shapes 2 to 21), a square light (shape 22) and a sphere light (shape 23) above.
+fn shaft_scene(rng: &mut Pcg32) -> (Geometry, [Vec3; 4], Sphere) {
+    let floor = [
+        (0.0, 0.0),
+        (10.0, 0.0),
+        (10.0, 10.0),
+        (0.0, 0.0),
+        (10.0, 10.0),
+        (0.0, 10.0),
+    ];
+    let mut shapes = vec![triangles_shape(
+        floor.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect(),
+    )];
+    let mut small = Vec::new();
+    for _ in 0..40 {
+        let centre = Vec3::new(
+            10.0 * rng.next_f32(),
+            0.3 + 3.0 * rng.next_f32(),
+            10.0 * rng.next_f32(),
+        );
+        small.extend((0..3).map(|_| centre + random_unit(rng) * 0.4));
+    }
+    shapes.push(triangles_shape(small));
+    for _ in 0..20 {
+        let center = Vec3::new(
+            10.0 * rng.next_f32(),
+            0.3 + 3.0 * rng.next_f32(),
+            10.0 * rng.next_f32(),
+        );
+        shapes.push(ShapeInput {
+            geometry: ShapeGeometry::Sphere(Sphere {
+                center,
+                radius: 0.1 + 0.2 * rng.next_f32(),
+            }),
+            flip_normals: false,
+            rotation: None,
+        });
+    }
+    let corners =
+        [(3.0, 3.0), (5.0, 3.0), (5.0, 5.0), (3.0, 5.0)].map(|(x, z)| Vec3::new(x, 4.0, z));
+    let [a, b, c, d] = corners;
+    shapes.push(triangles_shape(vec![a, b, c, a, c, d]));
+    let light = Sphere {
+        center: Vec3::new(7.0, 4.5, 6.0),
+        radius: 0.6,
+    };
+    shapes.push(ShapeInput {
+        geometry: ShapeGeometry::Sphere(light),
+        flip_normals: false,
+        rotation: None,
+    });
+    (Geometry::build(shapes), corners, light)
+}
+
+/// A random point of the rectangle of `corners`, or of `sphere`'s side seen from `apex`.
+fn point_on_light(rng: &mut Pcg32, corners: &[Vec3; 4], sphere: Option<(&Sphere, Vec3)>) -> Vec3 {
+    let Some((sphere, apex)) = sphere else {
+        let (u, v) = (rng.next_f32(), rng.next_f32());
+        return corners[0] + (corners[1] - corners[0]) * u + (corners[3] - corners[0]) * v;
+    };
+    loop {
+        let point = sphere.center + random_unit(rng) * sphere.radius;
+        if (point - sphere.center).dot(apex - point) > 0.0 {
+            return point;
+        }
+    }
+}
+
+#[test]
+fn every_ray_in_a_clear_shaft_is_free() {
+    let mut rng = Pcg32::new(23, 5);
+    let (geometry, corners, sphere) = shaft_scene(&mut rng);
+    let (mut clear, mut not_clear) = ([0; 2], [0; 2]);
+    for gather in 0..3000 {
+        let point = Vec3::new(10.0 * rng.next_f32(), 0.0, 10.0 * rng.next_f32());
+        let apex = offset_origin(point, Vec3::Y, Vec3::Y);
+        let surface = LeavingSurface {
+            point,
+            normal: Vec3::Y,
+            offset: apex.y - point.y,
+        };
+        let shafts = [
+            (Shaft::to_rectangle(apex, corners, surface), 22, None),
+            (
+                Shaft::to_sphere(apex, sphere, surface),
+                23,
+                Some((&sphere, apex)),
+            ),
+        ];
+        for (kind, (shaft, own_shape, on_sphere)) in shafts.into_iter().enumerate() {
+            let shaft = shaft.expect("both lights lie wholly above the floor");
+            if !geometry.shaft_is_clear(&shaft, own_shape) {
+                not_clear[kind] += 1;
+                continue;
+            }
+            clear[kind] += 1;
+            for i in 0..64 {
+                let target = point_on_light(&mut rng, &corners, on_sphere);
+                let ray = spawn_ray_to(point, Vec3::Y, target);
+                assert_eq!(ray.origin, apex);
+                // Nothing but the light may block it. (A ray grazing a sphere light's rim
+                // can meet the sphere itself within rounding, which a clear shaft does not
+                // count: the segment to a point seen on a sphere never enters it.)
+                let blocker = geometry.intersect_brute_force(&ray);
+                let other = blocker.filter(|hit| hit.shape != own_shape);
+                assert!(
+                    other.is_none(),
+                    "gather {gather}, light {kind}, ray {i}: {other:?}"
+                );
+            }
+        }
+    }
+    // Both answers must be exercised, for both kinds of light.
+    for kind in 0..2 {
+        assert!(
+            clear[kind] > 300 && not_clear[kind] > 300,
+            "{clear:?} clear, {not_clear:?} not"
+        );
+    }
 }
 
 /// A random point on the sphere or on the acne test's triangle.

@@ -4,6 +4,7 @@
 
 use super::primitive::Packed;
 use super::ray::Ray;
+use super::shaft::Shaft;
 use super::triangle_lanes::TriangleLanes;
 use super::Closest;
 use glam::{UVec2, Vec3A};
@@ -25,6 +26,10 @@ macro_rules! walk {
         );
     }};
 }
+
+/// The most nodes a shaft's traversal holds to visit (eight children per level, so enough
+/// for a BVH deeper than obvhs allows).
+const SHAFT_STACK: usize = 256;
 
 /// A CWBVH and its primitives' triangles in lanes.
 pub(super) struct LanedBvh {
@@ -89,6 +94,44 @@ impl LanedBvh {
         } else {
             index as u32 | 1 << 31
         }
+    }
+
+    /// Whether every primitive lies outside `shaft` or is passed over by `outside(index)`,
+    /// which answers for each primitive in a node box that reaches into the shaft; stops
+    /// at the first that does not.
+    pub(super) fn clear_of(&self, shaft: &Shaft, mut outside: impl FnMut(usize) -> bool) -> bool {
+        let total = &self.bvh.total_aabb;
+        let magnitude = Vec3A::max(total.min.abs(), total.max.abs()).max_element();
+        let margin = shaft.box_margin(magnitude);
+        if self.bvh.nodes.is_empty() || shaft.excludes_box(total, margin) {
+            return true;
+        }
+        let mut stack = [0u32; SHAFT_STACK];
+        let mut depth = 1;
+        while depth > 0 {
+            depth -= 1;
+            let node = &self.bvh.nodes[stack[depth] as usize];
+            for child in 0..8 {
+                if node.is_child_empty(child) || shaft.excludes_box(&node.child_aabb(child), margin)
+                {
+                    continue;
+                }
+                if node.is_leaf(child) {
+                    let (first, count) = node.child_primitives(child);
+                    if !(first..first + count).all(|index| outside(index as usize)) {
+                        return false;
+                    }
+                } else if depth == SHAFT_STACK {
+                    // Deeper than any BVH obvhs validates: give no answer rather than a
+                    // wrong one.
+                    return false;
+                } else {
+                    stack[depth] = node.child_node_index(child);
+                    depth += 1;
+                }
+            }
+        }
+        true
     }
 
     /// Whether primitive `index` is a triangle (in the lanes).

@@ -11,6 +11,7 @@ mod primitive;
 mod quadric;
 mod ray;
 mod recent_blockers;
+mod shaft;
 mod triangle_lanes;
 
 pub use basis::basis;
@@ -21,6 +22,7 @@ pub use primitive::{Primitive, Sphere, Triangle};
 pub use quadric::{Quadric, QuadricKind, QuadricSample, QuadricSurface};
 pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
 pub use recent_blockers::RecentBlockers;
+pub use shaft::{LeavingSurface, Shaft};
 
 use crate::mesh::{AttributeSite, MeshAttribute, TriangleMesh};
 use cwbvh_traversal::LanedBvh;
@@ -526,6 +528,39 @@ impl Geometry {
             #[cfg(feature = "embree")]
             Some(Accelerator::Embree(scene)) => scene.occluded(ray),
         }
+    }
+
+    /// Whether nothing but shape `own_shape` (the light the shaft aims at, which its rays
+    /// end before) reaches into `shaft`: then every ray from the shaft's apex toward the
+    /// light is free. `false` means only that some primitive may block some of those rays
+    /// (Embree's scenes, which this traversal cannot read, always answer `false`).
+    pub fn shaft_is_clear(&self, shaft: &Shaft, own_shape: u32) -> bool {
+        match &self.accelerator {
+            None => true,
+            Some(Accelerator::Cwbvh(bvh)) => {
+                bvh.clear_of(shaft, |index| self.outside_shaft(index, shaft, own_shape))
+            }
+            #[cfg(feature = "embree")]
+            Some(Accelerator::Embree(_)) => false,
+        }
+    }
+
+    /// Whether primitive `index` surely lies outside `shaft`, or belongs to `own_shape`.
+    fn outside_shaft(&self, index: usize, shaft: &Shaft, own_shape: u32) -> bool {
+        match self.packed[index] {
+            Packed::Triangle([v0, e1, e2]) => {
+                self.shape_of(index) == own_shape || shaft.excludes_triangle([v0, v0 + e1, v0 + e2])
+            }
+            Packed::Sphere(sphere) => {
+                self.shape_of(index) == own_shape || shaft.excludes_sphere(&sphere)
+            }
+            Packed::Quadric(_) | Packed::Instance(_) => false,
+        }
+    }
+
+    /// The scene's index of the shape primitive `index` belongs to (not an instance).
+    fn shape_of(&self, index: usize) -> u32 {
+        self.shape_ids[self.sources[index].shape as usize]
     }
 
     fn shade(&self, index: usize, ray: &Ray, t: f32, barycentrics: Vec2) -> Hit {

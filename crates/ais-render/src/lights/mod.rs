@@ -31,7 +31,7 @@ pub use spherical_rectangle::{Rectangle, LEAST_F32_SOLID_ANGLE};
 pub use toward::Toward;
 use toward::{AreaPoint, Source};
 
-use crate::geometry::Ray;
+use crate::geometry::{LeavingSurface, Ray, Shaft};
 use ais::sampling::AliasTable;
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -478,6 +478,44 @@ impl Lights {
         self.environment
             .as_ref()
             .map_or(Vec3::ZERO, |e| e.radiance(direction))
+    }
+
+    /// The area light whose point `toward` aims at, where it is a rectangle or a sphere (the
+    /// lights whose shafts [`Lights::shaft_toward`] bounds).
+    pub fn aimed_shaft_light(&self, toward: &Toward) -> Option<usize> {
+        let Source::Area(point) = toward.source else {
+            return None;
+        };
+        match self.area[point.light].shape {
+            AreaShape::Rectangle(_) | AreaShape::Sphere { flipped: false, .. } => Some(point.light),
+            _ => None,
+        }
+    }
+
+    /// The shaft from `apex`, the offset origin of rays leaving `surface`, toward area light
+    /// `light` (a rectangle, or a sphere emitting outward), with the light's geometry
+    /// shape; `None` for other lights, or where the shaft cannot bound the rays
+    /// ([`Shaft::to_rectangle`], [`Shaft::to_sphere`]).
+    pub fn shaft_toward(
+        &self,
+        light: usize,
+        apex: Vec3,
+        surface: LeavingSurface,
+    ) -> Option<(Shaft, u32)> {
+        let light = &self.area[light];
+        let shaft = match &light.shape {
+            AreaShape::Rectangle(rectangle) => {
+                let (corner, x, y) = (rectangle.corner, rectangle.edge_x, rectangle.edge_y);
+                let corners = [corner, corner + x, corner + x + y, corner + y];
+                Shaft::to_rectangle(apex, corners, surface)
+            }
+            AreaShape::Sphere {
+                sphere,
+                flipped: false,
+            } => Shaft::to_sphere(apex, *sphere, surface),
+            _ => None,
+        }?;
+        Some((shaft, light.shape_index))
     }
 
     /// Radiance emitted toward `-direction` by shape `shape` at a point with geometric

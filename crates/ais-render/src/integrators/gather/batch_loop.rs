@@ -7,6 +7,7 @@ use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
 use super::mis_share::ShareMoments;
 use super::settings::GatherSettings;
+use super::shared_origin::SharedOrigin;
 use super::strategy::{CandidateDraw, GatherPoint, MisParts};
 use crate::geometry::RecentBlockers;
 use crate::lights::{luminance, EnvironmentDraws, RectangleDraws, Toward};
@@ -164,7 +165,7 @@ fn run_ahead(
     let mut drawn = [None; AHEAD];
     let mut weights = [1.0; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
-    let mut blockers = RecentBlockers::default();
+    let mut origin = SharedOrigin::default();
     loop {
         let count = draw_ahead(run, batch, &mut drawn, &mut weights);
         if count == 0 {
@@ -172,7 +173,7 @@ fn run_ahead(
         }
         let shadow_rays = ShadowRays {
             counts,
-            blockers: &mut blockers,
+            origin: &mut origin,
         };
         trace_run(run, &mut drawn[..count], &mut arriving, shadow_rays);
         let traced = drawn[..count].iter_mut().flatten().zip(&arriving);
@@ -183,10 +184,10 @@ fn run_ahead(
     }
 }
 
-/// Where a gather's shadow rays are counted, and the blockers they try first.
+/// Where a gather's shadow rays are counted, and what they learn from one another.
 struct ShadowRays<'a> {
     counts: &'a mut RayCounts,
-    blockers: &'a mut RecentBlockers,
+    origin: &'a mut SharedOrigin,
 }
 
 /// Finds what the drawn candidates of a run meet among the lights, together (`drawn`; empty
@@ -200,9 +201,10 @@ fn trace_run(
     rays: ShadowRays,
 ) {
     run.world.lights.resolve_run(&run.at.receiver, drawn);
+    rays.origin.expect_run(run.world, drawn);
     let mut blocked = [None; AHEAD];
     for (toward, blocked) in drawn.iter_mut().flatten().zip(&mut blocked) {
-        *blocked = trace_aimed(run.world, run.at, toward, rays.counts, rays.blockers);
+        *blocked = trace_aimed(run.world, run.at, toward, rays.counts, rays.origin);
     }
     let looked_up = drawn.iter_mut().flatten().zip(&blocked);
     for ((toward, blocked), arriving) in looked_up.zip(arriving) {
@@ -224,7 +226,7 @@ fn run_plain(
     let mut tally = PlainTally::default();
     let mut drawn = [None; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
-    let mut blockers = RecentBlockers::default();
+    let mut origin = SharedOrigin::default();
     for numbers in batch.begin_plain(run.rays, run.seed).chunks(AHEAD) {
         let drawn = &mut drawn[..numbers.len()];
         draw_into(run, numbers, drawn);
@@ -233,7 +235,7 @@ fn run_plain(
         tally.traced += kept as u32;
         let shadow_rays = ShadowRays {
             counts,
-            blockers: &mut blockers,
+            origin: &mut origin,
         };
         trace_run(run, drawn, &mut arriving, shadow_rays);
         for (toward, &arriving) in drawn.iter_mut().flatten().zip(&arriving) {
@@ -361,7 +363,7 @@ fn run_one_by_one<P: BatchProbe>(
     let at = run.at;
     let value_only = batch.map().is_none() && batch.observations().is_none();
     let mut values = RunningMean::default();
-    let mut blockers = RecentBlockers::default();
+    let mut origin = SharedOrigin::default();
     while let Some(candidate) = batch.next_candidate() {
         let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
             probe.decided(at.frame.normal, false);
@@ -374,9 +376,9 @@ fn run_one_by_one<P: BatchProbe>(
         if let Decision::Trace { weight } = decision {
             let started = run.clock.map(|_| Instant::now());
             let traced = if value_only && known.is_none() {
-                traced_value(run, toward, counts, &mut blockers)
+                traced_value(run, toward, counts, &mut origin)
             } else {
-                trace(run, toward, known, counts, &mut blockers)
+                trace(run, toward, known, counts, &mut origin.blockers)
             };
             record(run, batch, lessons, &mut toward, &traced, weight);
             if let (Some(clock), Some(started)) = (run.clock, started) {
@@ -505,15 +507,15 @@ struct Traced {
 /// Traces an accepted candidate whose value alone is wanted (with whether its ray was
 /// free, for a recorder): the density, the BSDF and the environment's radiance are looked
 /// up only if its shadow ray is free. The same value as [`trace`] gives; the rating is 0,
-/// as nothing reads it (the batch has no map to learn). `blockers` remembers what
-/// blocked the gather's rays ([`RecentBlockers`]).
+/// as nothing reads it (the batch has no map to learn). `origin` holds what the gather's
+/// earlier rays learned ([`SharedOrigin`]).
 fn traced_value(
     run: &BatchRun,
     mut toward: Toward,
     counts: &mut RayCounts,
-    blockers: &mut RecentBlockers,
+    origin: &mut SharedOrigin,
 ) -> Traced {
-    let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts, blockers);
+    let shadow_ray = free_radiance(run.world, run.at, &mut toward, counts, origin);
     value_of(run, &mut toward, shadow_ray)
 }
 
@@ -568,8 +570,8 @@ fn brought(
     Some((at.scattering(toward) * radiance / pdf as f32, parts))
 }
 
-/// Traces an accepted candidate: its contribution f·L/p and what it saw (`blockers` as
-/// in [`traced_value`]).
+/// Traces an accepted candidate: its contribution f·L/p and what it saw (`blockers`: the
+/// gather's recent blockers, tried first).
 fn trace(
     run: &BatchRun,
     mut toward: Toward,

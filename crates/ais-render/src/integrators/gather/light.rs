@@ -1,6 +1,7 @@
 //! Light arriving at a gather point along a candidate direction: what it would bring with
 //! nothing in the way, and what the occlusion ray lets through.
 
+use super::shared_origin::SharedOrigin;
 use super::strategy::GatherPoint;
 use crate::geometry::{spawn_ray, spawn_ray_to, Ray, RecentBlockers};
 use crate::lights::{Aim, Toward};
@@ -76,21 +77,21 @@ pub enum ShadowRay {
 /// The radiance a candidate brings if its shadow ray is free. The ray is traced before the
 /// radiance is looked up (for the environment, a texture lookup), which a blocked ray does
 /// not need; so a ray toward a black part of the environment is traced (and counted),
-/// where [`Leaving`] would know not to. `blockers` as in [`trace_aimed`].
+/// where [`Leaving`] would know not to. `origin` as in [`trace_aimed`].
 pub fn free_radiance(
     world: &World,
     at: &GatherPoint,
     toward: &mut Toward,
     counts: &mut RayCounts,
-    blockers: &mut RecentBlockers,
+    origin: &mut SharedOrigin,
 ) -> ShadowRay {
-    let blocked = trace_aimed(world, at, toward, counts, blockers);
+    let blocked = trace_aimed(world, at, toward, counts, origin);
     radiance_if_free(world, at, toward, blocked)
 }
 
 /// Whether the shadow ray of `toward` is blocked (`None`: no ray was needed, the candidate
-/// surely brings nothing), tried first near what blocked the gather's earlier rays
-/// (`blockers`). The first half of [`free_radiance`], for gathers that trace several
+/// surely brings nothing), answered with what the gather's earlier rays learned
+/// (`origin`). The first half of [`free_radiance`], for gathers that trace several
 /// candidates' rays before looking up what the free ones bring.
 #[inline]
 pub fn trace_aimed(
@@ -98,7 +99,7 @@ pub fn trace_aimed(
     at: &GatherPoint,
     toward: &mut Toward,
     counts: &mut RayCounts,
-    blockers: &mut RecentBlockers,
+    origin: &mut SharedOrigin,
 ) -> Option<bool> {
     let target = match world.lights.aim(&at.receiver, toward) {
         Aim::Nothing => return None,
@@ -107,7 +108,7 @@ pub fn trace_aimed(
     };
     counts.occlusion += 1;
     let ray = shadow_ray(at, toward.direction, target);
-    Some(world.geometry.occluded_after(&ray, blockers))
+    Some(origin.occluded(world, at, toward, &ray))
 }
 
 /// The second half of [`free_radiance`]: what `toward` (aimed by [`trace_aimed`]) brings,

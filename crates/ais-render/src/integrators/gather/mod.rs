@@ -24,6 +24,7 @@ mod light;
 pub mod mis_share;
 pub mod race;
 pub mod settings;
+mod shared_origin;
 pub mod strategy;
 
 pub use acceptance::Acceptance;
