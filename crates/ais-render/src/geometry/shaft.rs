@@ -21,6 +21,12 @@ const MOST_PLANES: usize = 6;
 /// must lie outside a plane (2^-22: about four units in the last place).
 const RELATIVE_MARGIN: f32 = 1.0 / 4_194_304.0;
 
+/// How far, relative to the coordinates' magnitude, the apex must lie from a flat light's
+/// plane. A ray ends short of the light by 1e-4 of its length, so it ends 1e-4 of the
+/// apex's height above the plane: from nearer, rays graze the plane, and tracing one can
+/// find it blocked by the light itself within rounding. Such rays are left to be traced.
+const LEAST_HEIGHT: f32 = 1.0 / 64.0;
+
 /// A plane `normal · x = offset`; the shaft lies where `normal · x ≤ offset`.
 #[derive(Clone, Copy, Debug)]
 struct Plane {
@@ -99,9 +105,12 @@ impl Shaft {
             facing
         };
         let far = Plane::through(corners[0], far_normal);
+        let magnitude = (corners.iter().chain([&apex]))
+            .map(|p| p.abs().max_element())
+            .fold(1.0, f32::max);
         let degenerate = sides.iter().any(|side| side.normal == Vec3::ZERO)
             || facing == Vec3::ZERO
-            || -far.outside_by(apex) <= Self::margin_at(apex, apex);
+            || -far.outside_by(apex) < LEAST_HEIGHT * magnitude;
         if degenerate {
             return None;
         }
@@ -169,11 +178,6 @@ impl Shaft {
             bounds,
             apex_magnitude: apex.abs().max_element().max(1.0),
         })
-    }
-
-    /// The margin a test at `point` needs, for a shaft whose apex is `apex`.
-    fn margin_at(point: Vec3, apex: Vec3) -> f32 {
-        RELATIVE_MARGIN * (point.abs().max_element() + apex.abs().max_element() + 1.0)
     }
 
     /// The margin for boxes in a scene whose coordinates reach `magnitude` at most: one

@@ -27,6 +27,8 @@ pub struct MeshEmitter {
     /// Each triangle's texture coordinates at its vertices, in BVH order (for a textured
     /// radiance).
     texcoords: Option<Vec<[Vec2; 3]>>,
+    /// Where all the triangles lie in one plane: a rectangle in it around them all.
+    outline: Option<[Vec3; 4]>,
 }
 
 impl MeshEmitter {
@@ -53,6 +55,7 @@ impl MeshEmitter {
             .map(|t| 0.5 * t.normal().length() as f64)
             .collect();
         MeshEmitter {
+            outline: planar_outline(&triangles),
             choice: AliasTable::new(&areas),
             area: areas.iter().sum(),
             triangles,
@@ -69,6 +72,12 @@ impl MeshEmitter {
         let [a, b, c] = texcoords[spot.triangle as usize];
         let (u, v) = (spot.barycentrics.x, spot.barycentrics.y);
         a * (1.0 - u - v) + b * u + c * v
+    }
+
+    /// Where the mesh is flat: the corners, in order, of a rectangle in its plane around all
+    /// its triangles.
+    pub fn outline(&self) -> Option<[Vec3; 4]> {
+        self.outline
     }
 
     /// Total area.
@@ -161,5 +170,91 @@ impl MeshEmitter {
                 barycentrics,
             },
         })
+    }
+}
+
+/// The corners of a rectangle around `triangles` in their plane, if they all lie in one
+/// (each vertex within a millionth of the mesh's size of the first triangle's plane). The
+/// rectangle's sides follow the first triangle's edge that makes it smallest: a quad's
+/// outline is the quad itself.
+fn planar_outline(triangles: &[Triangle]) -> Option<[Vec3; 4]> {
+    let first = triangles.first()?;
+    let normal = first.normal().try_normalize()?;
+    let origin = first.vertices[0];
+    let vertices = || triangles.iter().flat_map(|t| t.vertices);
+    let size = vertices()
+        .map(|v| (v - origin).abs().max_element())
+        .fold(0.0, f32::max);
+    if !vertices().all(|v| normal.dot(v - origin).abs() <= 1e-6 * size) {
+        return None;
+    }
+    let [a, b, c] = first.vertices;
+    let outlines = [b - a, c - b, a - c].into_iter().filter_map(|edge| {
+        let u = edge.try_normalize()?;
+        Some(outline_along(
+            vertices(),
+            origin,
+            [u, normal.cross(u)],
+            size,
+        ))
+    });
+    outlines.min_by(|p, q| area_of(p).total_cmp(&area_of(q)))
+}
+
+/// The rectangle around `vertices` with sides along the unit, orthogonal `axes`, a little
+/// wider than they reach so that rounding leaves none outside.
+fn outline_along(
+    vertices: impl Iterator<Item = Vec3>,
+    origin: Vec3,
+    axes: [Vec3; 2],
+    size: f32,
+) -> [Vec3; 4] {
+    let [u, v] = axes;
+    let (mut low, mut high) = (Vec2::splat(f32::INFINITY), Vec2::splat(-f32::INFINITY));
+    for vertex in vertices {
+        let along = Vec2::new(u.dot(vertex - origin), v.dot(vertex - origin));
+        (low, high) = (low.min(along), high.max(along));
+    }
+    let (low, high) = (low - 1e-5 * size, high + 1e-5 * size);
+    let at = |p: Vec2| origin + u * p.x + v * p.y;
+    [
+        at(low),
+        at(Vec2::new(high.x, low.y)),
+        at(high),
+        at(Vec2::new(low.x, high.y)),
+    ]
+}
+
+/// The area of a rectangle of `corners` in order.
+fn area_of(corners: &[Vec3; 4]) -> f32 {
+    (corners[1] - corners[0]).length() * (corners[3] - corners[0]).length()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn triangle(vertices: [Vec3; 3]) -> Triangle {
+        Triangle {
+            vertices,
+            mesh: 0,
+            index: 0,
+        }
+    }
+
+    #[test]
+    fn a_flat_mesh_has_an_outline_around_its_triangles_and_a_bent_one_none() {
+        let [a, b, c, d] = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+            .map(|(x, z)| Vec3::new(0.25 * x, 1.99, 0.25 * z));
+        // The first triangle's first edge a diagonal of the quad: the outline still follows
+        // the quad's sides.
+        let flat = [triangle([a, c, d]), triangle([a, b, c])];
+        let outline = planar_outline(&flat).expect("a flat quad");
+        for corner in outline {
+            assert!((corner.y - 1.99).abs() < 1e-6, "{corner}");
+            assert!((corner.x.abs() - 0.25).abs() < 1e-4 && (corner.z.abs() - 0.25).abs() < 1e-4);
+        }
+        let bent = [triangle([a, b, c]), triangle([a, c, d + Vec3::Y * 0.01])];
+        assert!(planar_outline(&bent).is_none());
     }
 }

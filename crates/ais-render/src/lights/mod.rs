@@ -480,22 +480,25 @@ impl Lights {
             .map_or(Vec3::ZERO, |e| e.radiance(direction))
     }
 
-    /// The area light whose point `toward` aims at, where it is a rectangle or a sphere (the
-    /// lights whose shafts [`Lights::shaft_toward`] bounds).
+    /// The area light whose point `toward` aims at, where it is a rectangle, a sphere or a
+    /// flat mesh (the lights whose shafts [`Lights::shaft_toward`] bounds).
     pub fn aimed_shaft_light(&self, toward: &Toward) -> Option<usize> {
         let Source::Area(point) = toward.source else {
             return None;
         };
-        match self.area[point.light].shape {
-            AreaShape::Rectangle(_) | AreaShape::Sphere { flipped: false, .. } => Some(point.light),
-            _ => None,
-        }
+        let bounded = match &self.area[point.light].shape {
+            AreaShape::Rectangle(_) | AreaShape::Sphere { flipped: false, .. } => true,
+            AreaShape::Triangles(mesh) => mesh.outline().is_some(),
+            _ => false,
+        };
+        bounded.then_some(point.light)
     }
 
     /// The shaft from `apex`, the offset origin of rays leaving `surface`, toward area light
-    /// `light` (a rectangle, or a sphere emitting outward), with the light's geometry
-    /// shape; `None` for other lights, or where the shaft cannot bound the rays
-    /// ([`Shaft::to_rectangle`], [`Shaft::to_sphere`]).
+    /// `light` (a rectangle, a sphere emitting outward, or a flat mesh by a rectangle
+    /// around it in its plane), with the light's geometry shape; `None` for other lights,
+    /// or where the shaft cannot bound the rays ([`Shaft::to_rectangle`],
+    /// [`Shaft::to_sphere`]).
     pub fn shaft_toward(
         &self,
         light: usize,
@@ -513,6 +516,7 @@ impl Lights {
                 sphere,
                 flipped: false,
             } => Shaft::to_sphere(apex, *sphere, surface),
+            AreaShape::Triangles(mesh) => Shaft::to_rectangle(apex, mesh.outline()?, surface),
             _ => None,
         }?;
         Some((shaft, light.shape_index))
