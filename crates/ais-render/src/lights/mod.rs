@@ -57,6 +57,8 @@ pub struct Lights {
     /// Whether there are area lights and all are rectangles: a run's directions are then
     /// resolved together ([`Lights::resolve_run`]).
     only_rectangles: bool,
+    /// Per area light, whether a shaft can bound its rays ([`Lights::shaft_toward`]).
+    bounded_by_shafts: Vec<bool>,
 }
 
 /// Where a field cell counts each light's rays: one source per light, or, for the lights
@@ -95,6 +97,16 @@ pub enum Aim {
     Unbounded,
 }
 
+/// Whether a shaft can bound the rays toward `light` ([`Lights::shaft_toward`]): a
+/// rectangle, a sphere emitting outward, or a flat mesh.
+fn bounded_by_shafts(light: &AreaLight) -> bool {
+    match &light.shape {
+        AreaShape::Rectangle(_) | AreaShape::Sphere { flipped: false, .. } => true,
+        AreaShape::Triangles(mesh) => mesh.outline().is_some(),
+        _ => false,
+    }
+}
+
 /// A scene's emitters, before [`Lights::new`] weighs them.
 #[derive(Clone, Debug, Default)]
 pub struct Emitters {
@@ -129,6 +141,7 @@ impl Lights {
         regions.resize(weights.len(), false);
         Lights {
             only_rectangles: !area.is_empty() && area.iter().all(|l| l.rectangle().is_some()),
+            bounded_by_shafts: area.iter().map(bounded_by_shafts).collect(),
             environment,
             area,
             delta,
@@ -482,16 +495,12 @@ impl Lights {
 
     /// The area light whose point `toward` aims at, where it is a rectangle, a sphere or a
     /// flat mesh (the lights whose shafts [`Lights::shaft_toward`] bounds).
+    #[inline]
     pub fn aimed_shaft_light(&self, toward: &Toward) -> Option<usize> {
         let Source::Area(point) = toward.source else {
             return None;
         };
-        let bounded = match &self.area[point.light].shape {
-            AreaShape::Rectangle(_) | AreaShape::Sphere { flipped: false, .. } => true,
-            AreaShape::Triangles(mesh) => mesh.outline().is_some(),
-            _ => false,
-        };
-        bounded.then_some(point.light)
+        self.bounded_by_shafts[point.light].then_some(point.light)
     }
 
     /// The shaft from `apex`, the offset origin of rays leaving `surface`, toward area light
