@@ -331,12 +331,15 @@ fn every_ray_in_a_clear_shaft_is_free() {
             }
         }
     }
-    // Both answers must be exercised, for both kinds of light.
+    // Both answers must be exercised, for both kinds of light. Embree's scenes cannot be
+    // read by the shaft's traversal: they never answer that a shaft is clear.
     for kind in 0..2 {
-        assert!(
-            clear[kind] > 300 && not_clear[kind] > 300,
-            "{clear:?} clear, {not_clear:?} not"
-        );
+        if cfg!(feature = "embree") {
+            assert_eq!(clear[kind], 0, "Embree answers no shaft");
+        } else {
+            let both = clear[kind] > 300 && not_clear[kind] > 300;
+            assert!(both, "{clear:?} clear, {not_clear:?} not");
+        }
     }
 }
 
