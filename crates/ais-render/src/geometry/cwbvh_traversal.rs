@@ -102,7 +102,7 @@ impl LanedBvh {
     pub(super) fn clear_of(&self, shaft: &Shaft, mut outside: impl FnMut(usize) -> bool) -> bool {
         let total = &self.bvh.total_aabb;
         let magnitude = Vec3A::max(total.min.abs(), total.max.abs()).max_element();
-        let margin = shaft.box_margin(magnitude);
+        let margin = shaft.margin_for(magnitude);
         if self.bvh.nodes.is_empty() || shaft.excludes_box(total, margin) {
             return true;
         }

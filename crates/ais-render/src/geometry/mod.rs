@@ -547,15 +547,12 @@ impl Geometry {
 
     /// Whether primitive `index` surely lies outside `shaft`, or belongs to `own_shape`.
     fn outside_shaft(&self, index: usize, shaft: &Shaft, own_shape: u32) -> bool {
-        match self.packed[index] {
-            Packed::Triangle([v0, e1, e2]) => {
-                self.shape_of(index) == own_shape || shaft.excludes_triangle([v0, v0 + e1, v0 + e2])
-            }
-            Packed::Sphere(sphere) => {
-                self.shape_of(index) == own_shape || shaft.excludes_sphere(&sphere)
-            }
-            Packed::Quadric(_) | Packed::Instance(_) => false,
-        }
+        let excluded = match self.packed[index] {
+            Packed::Triangle([v0, e1, e2]) => shaft.excludes_triangle([v0, v0 + e1, v0 + e2]),
+            Packed::Sphere(sphere) => shaft.excludes_sphere(&sphere),
+            Packed::Quadric(_) | Packed::Instance(_) => return false,
+        };
+        excluded || self.shape_of(index) == own_shape
     }
 
     /// The scene's index of the shape primitive `index` belongs to (not an instance).

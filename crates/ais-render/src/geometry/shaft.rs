@@ -82,7 +82,8 @@ pub struct Shaft {
 impl Shaft {
     /// The shaft from `surface`'s offset origin `apex` toward a rectangle of corners
     /// `corners` (in order around it), or `None` where the rectangle does not lie wholly in
-    /// front of the surface, or the apex lies in its plane.
+    /// front of the surface, or the apex lies within 1/64 of the coordinates' magnitude of
+    /// its plane (its rays would graze the light).
     pub fn to_rectangle(apex: Vec3, corners: [Vec3; 4], surface: LeavingSurface) -> Option<Self> {
         let centre = corners.iter().sum::<Vec3>() * 0.25;
         let sides: [Plane; 4] = std::array::from_fn(|i| {
@@ -153,9 +154,9 @@ impl Shaft {
         Self::with_near_plane(apex, planes, bounds, surface, lowest)
     }
 
-    /// The shaft of `planes` and the near plane of `surface`, or `None` unless the light
-    /// lies at least `lowest` above the surface, as high as the apex: a ray from the apex
-    /// toward it then stays above the near plane all along.
+    /// The shaft of `planes` and the near plane of `surface`, or `None` unless the light's
+    /// lowest point, `lowest` above the surface, lies at least as high as the apex: a ray
+    /// from the apex toward the light then stays above the near plane all along.
     fn with_near_plane(
         apex: Vec3,
         planes: [Plane; 5],
@@ -180,13 +181,13 @@ impl Shaft {
         })
     }
 
-    /// The margin for boxes in a scene whose coordinates reach `magnitude` at most: one
-    /// margin for all of a traversal's boxes, the largest any of them needs.
-    pub fn box_margin(&self, magnitude: f32) -> f32 {
+    /// The margin for a test of coordinates that reach `magnitude` at most (for boxes, the
+    /// scene's: one margin for all of a traversal's boxes, the largest any of them needs).
+    pub fn margin_for(&self, magnitude: f32) -> f32 {
         RELATIVE_MARGIN * (magnitude + self.apex_magnitude + 1.0)
     }
 
-    /// Whether `aabb` lies wholly outside the shaft, by `margin` ([`Shaft::box_margin`]).
+    /// Whether `aabb` lies wholly outside the shaft, by `margin` ([`Shaft::margin_for`]).
     #[inline]
     pub fn excludes_box(&self, aabb: &Aabb, margin: f32) -> bool {
         let (min, max) = (Vec3::from(aabb.min), Vec3::from(aabb.max));
@@ -208,7 +209,7 @@ impl Shaft {
             .iter()
             .map(|v| v.abs().max_element())
             .fold(0.0, f32::max);
-        let margin = RELATIVE_MARGIN * (magnitude + self.apex_magnitude + 1.0);
+        let margin = self.margin_for(magnitude);
         self.planes.iter().any(|plane| {
             vertices
                 .iter()
@@ -219,8 +220,7 @@ impl Shaft {
     /// Whether `sphere` lies wholly outside the shaft (by a margin).
     #[inline]
     pub fn excludes_sphere(&self, sphere: &Sphere) -> bool {
-        let magnitude = sphere.center.abs().max_element() + sphere.radius;
-        let margin = RELATIVE_MARGIN * (magnitude + self.apex_magnitude + 1.0);
+        let margin = self.margin_for(sphere.center.abs().max_element() + sphere.radius);
         (self.planes.iter()).any(|plane| plane.outside_by(sphere.center) > sphere.radius + margin)
     }
 }
@@ -282,7 +282,7 @@ mod tests {
         // A sliver just above the floor, higher than the rays' origin, is kept.
         let lifted = floor.map(|v| v + Vec3::Y * 2.0 * surface.offset);
         assert!(!shaft.excludes_triangle(lifted));
-        let margin = shaft.box_margin(10.0);
+        let margin = shaft.margin_for(10.0);
         let beside = Aabb::new(
             Vec3::new(0.7, 1.9, -0.1).into(),
             Vec3::new(1.0, 2.1, 0.1).into(),

@@ -31,7 +31,7 @@ pub use spherical_rectangle::{Rectangle, LEAST_F32_SOLID_ANGLE};
 pub use toward::Toward;
 use toward::{AreaPoint, Source};
 
-use crate::geometry::{LeavingSurface, Ray, Shaft};
+use crate::geometry::{LeavingSurface, Ray, Shaft, Sphere};
 use ais::sampling::AliasTable;
 use glam::Vec3;
 use std::f64::consts::PI;
@@ -97,13 +97,25 @@ pub enum Aim {
     Unbounded,
 }
 
-/// Whether a shaft can bound the rays toward `light` ([`Lights::shaft_toward`]): a
-/// rectangle, a sphere emitting outward, or a flat mesh.
-fn bounded_by_shafts(light: &AreaLight) -> bool {
+/// What a shaft toward an area light is built around ([`Lights::shaft_toward`]).
+enum ShaftOutline {
+    /// A rectangle's corners, in order around it (a flat mesh's: a rectangle around it).
+    Rectangle([Vec3; 4]),
+    /// A sphere emitting outward.
+    Sphere(Sphere),
+}
+
+/// What a shaft toward `light` is built around: a rectangle, a sphere emitting outward, or
+/// a flat mesh; `None` for other lights.
+fn shaft_outline(light: &AreaLight) -> Option<ShaftOutline> {
     match &light.shape {
-        AreaShape::Rectangle(_) | AreaShape::Sphere { flipped: false, .. } => true,
-        AreaShape::Triangles(mesh) => mesh.outline().is_some(),
-        _ => false,
+        AreaShape::Rectangle(rectangle) => Some(ShaftOutline::Rectangle(rectangle.corners())),
+        AreaShape::Sphere {
+            sphere,
+            flipped: false,
+        } => Some(ShaftOutline::Sphere(*sphere)),
+        AreaShape::Triangles(mesh) => mesh.outline().map(ShaftOutline::Rectangle),
+        _ => None,
     }
 }
 
@@ -141,7 +153,7 @@ impl Lights {
         regions.resize(weights.len(), false);
         Lights {
             only_rectangles: !area.is_empty() && area.iter().all(|l| l.rectangle().is_some()),
-            bounded_by_shafts: area.iter().map(bounded_by_shafts).collect(),
+            bounded_by_shafts: area.iter().map(|l| shaft_outline(l).is_some()).collect(),
             environment,
             area,
             delta,
@@ -515,18 +527,9 @@ impl Lights {
         surface: LeavingSurface,
     ) -> Option<(Shaft, u32)> {
         let light = &self.area[light];
-        let shaft = match &light.shape {
-            AreaShape::Rectangle(rectangle) => {
-                let (corner, x, y) = (rectangle.corner, rectangle.edge_x, rectangle.edge_y);
-                let corners = [corner, corner + x, corner + x + y, corner + y];
-                Shaft::to_rectangle(apex, corners, surface)
-            }
-            AreaShape::Sphere {
-                sphere,
-                flipped: false,
-            } => Shaft::to_sphere(apex, *sphere, surface),
-            AreaShape::Triangles(mesh) => Shaft::to_rectangle(apex, mesh.outline()?, surface),
-            _ => None,
+        let shaft = match shaft_outline(light)? {
+            ShaftOutline::Rectangle(corners) => Shaft::to_rectangle(apex, corners, surface),
+            ShaftOutline::Sphere(sphere) => Shaft::to_sphere(apex, sphere, surface),
         }?;
         Some((shaft, light.shape_index))
     }

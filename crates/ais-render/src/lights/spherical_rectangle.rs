@@ -264,6 +264,12 @@ impl Rectangle {
         })
     }
 
+    /// Its four corners, in order around it.
+    pub fn corners(&self) -> [Vec3; 4] {
+        let (corner, x, y) = (self.corner, self.edge_x, self.edge_y);
+        [corner, corner + x, corner + x + y, corner + y]
+    }
+
     /// Area.
     pub fn area(&self) -> f64 {
         self.edge_x.cross(self.edge_y).length() as f64
