@@ -296,14 +296,6 @@ impl Material {
 
     /// BSDF times |cos θi| (zero outside the support).
     pub fn eval(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> Vec3 {
-        if let Scattering::Diffuse { reflectance } = self.scattering {
-            // The commonest material, without the general path's frame change of `wo`.
-            return if self.in_support(frame, wo, wi) {
-                reflectance * (wi.dot(frame.normal) / PI)
-            } else {
-                Vec3::ZERO
-            };
-        }
         if !self.in_support(frame, wo, wi) {
             return Vec3::ZERO;
         }
@@ -408,11 +400,6 @@ impl Material {
 
     /// Density of [`Material::sample`] at `wi`.
     pub fn pdf(&self, frame: &ShadingFrame, wo: Vec3, wi: Vec3) -> f64 {
-        if let Scattering::Diffuse { .. } = self.scattering {
-            // Cosine-weighted: the cosine alone, as the general path below works it out.
-            let cosine = wi.dot(frame.normal);
-            return if cosine <= 0.0 { 0.0 } else { (cosine / PI) as f64 };
-        }
         let (o, i) = (frame.to_local(wo), frame.to_local(wi));
         match self.scattering {
             Scattering::RoughDielectric(ref rough) => return rough.pdf(o, i) as f64,
