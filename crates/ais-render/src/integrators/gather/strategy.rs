@@ -238,7 +238,7 @@ impl Strategy {
     /// [`Strategy::sample_direction`], except that a draw from an environment map, a
     /// rectangle light or the BSDF is left to be made together with other candidates' of
     /// its kind ([`CandidateDraw`]).
-    #[inline(always)]
+    #[inline]
     pub fn begin_direction(self, at: &GatherPoint, u: [f32; 2]) -> CandidateDraw {
         match self.effective(at) {
             Strategy::Uniform => CandidateDraw::Made(Some(Toward::new(uniform_sphere(u)))),
