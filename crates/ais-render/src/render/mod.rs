@@ -196,8 +196,12 @@ fn render_passes<I: SampleIntegrator>(
         // for later renders, and only while the learning wants it.
         let learns = index + 1 < passes.len()
             || (learning_goes_on && learned.wants_observations(pass.first_sample));
+        // Tiles are handed out one at a time: in runs of several, a thread could be left
+        // with a run of costly tiles (a floor in shadow) while the others wait at the end.
+        // Results come back in tile order whatever the threads did.
         let results: Vec<_> = rects
             .par_iter()
+            .with_max_len(1)
             .map(|&rect| {
                 let tile = Tile {
                     rect,
