@@ -17,7 +17,9 @@ renderer in turn (ais at 2 and 1 threads, then each Mitsuba variant, which stays
 between rounds), so that the machine's drift between rounds touches them all alike.
 Reported per scene, medians over the rounds:
 - ais's render time at 2 threads (loading excluded: the "render time" line) and at 1 thread,
-  and the scaling between them (the median of the rounds' ratios);
+  and the scaling between them (the median of the rounds' ratios), with how many of the 2
+  threads were busy on average (short of 2 where one waited for the other's last tiles;
+  a scaling short of 2× with both busy is the machine, not the renderer);
 - Mitsuba 3's llvm_ad_rgb and scalar_rgb render times (`mi.render` after one warm-up
   render, so the llvm variant's JIT compilation is excluded; loading excluded);
 - rays per second, counted by ais for ais; for Mitsuba, the same nominal count
@@ -162,8 +164,8 @@ class MitsubaRenderer:
 
 
 def ais_render(scene, threads, args, seed, binary=None):
-    """Render time and counted rays of one `ais render` (`binary`, else --ais) of `scene` at
-    `threads`."""
+    """Render time, counted rays and threads busy on average (`time`, `rays`, `busy`) of one
+    `ais render` (`binary`, else --ais) of `scene` at `threads`."""
     with tempfile.TemporaryDirectory() as work:
         command = [binary or args.ais, "render", scene, "--resolution", args.size, "--spp", str(args.spp),
                    "--integrator", "gather", "--strategy", "mis", "--rays", str(args.rays), "--ais", "off",
@@ -174,7 +176,9 @@ def ais_render(scene, threads, args, seed, binary=None):
         crosscheck.fail_setup(f"`{' '.join(command)}` failed:\n{done.stderr.strip()}")
     report = done.stdout + done.stderr
     counted = re.search(r"rays\s+(\d+) camera \+ (\d+) occlusion", report)
-    return float(re.search(r"render time\s+([0-9.]+) s", report).group(1)), int(counted.group(1)) + int(counted.group(2))
+    timed = re.search(r"render time\s+([0-9.]+) s \(([0-9.]+) threads busy", report)
+    return {"time": float(timed.group(1)), "rays": int(counted.group(1)) + int(counted.group(2)),
+            "busy": float(timed.group(2))}
 
 
 def median_or_none(values):
@@ -198,9 +202,10 @@ def measure(scene, args, libllvm):
     rounds = []
     try:
         for k in range(args.runs):
-            ais2, rays = ais_render(scene, 2, args, k)
-            one = {"ais_2": ais2, "ais_rays": rays, "ais_1": ais_render(scene, 1, args, k)[0],
-                   "embree_2": ais_render(scene, 2, args, k, args.ais_embree)[0] if args.ais_embree else None}
+            two = ais_render(scene, 2, args, k)
+            one = {"ais_2": two["time"], "ais_rays": two["rays"], "busy_2": two["busy"],
+                   "ais_1": ais_render(scene, 1, args, k)["time"],
+                   "embree_2": ais_render(scene, 2, args, k, args.ais_embree)["time"] if args.ais_embree else None}
             for variant, renderer in mitsuba.items():
                 one[variant] = renderer.render()
             rounds.append(one)
@@ -228,7 +233,7 @@ def print_rows(rows, markdown):
         return f"{rays / time / 1e6:.1f} M" if time else "—"
 
     header = ["scene", "ais 2 thr (s)", "ais rays/s", "Mitsuba llvm (s)", "llvm rays/s (nominal)",
-              "llvm / ais", "Mitsuba scalar (s)", "ais 1 thr (s)", "1 → 2 threads"]
+              "llvm / ais", "Mitsuba scalar (s)", "ais 1 thr (s)", "1 → 2 threads", "threads busy at 2"]
     embree = any(row["embree_2"] for row in rows)
     if embree:
         header += ["ais Embree 2 thr (s)", "llvm / ais Embree"]
@@ -237,7 +242,8 @@ def print_rows(rows, markdown):
         llvm = row["llvm_ad_rgb"]
         lines.append([row["scene"], seconds(row["ais_2"]), rate(row["ais_rays"], row["ais_2"]), seconds(llvm),
                       rate(row["nominal_rays"], llvm), f"{row['llvm_ratio']:.2f}×" if row["llvm_ratio"] else "—",
-                      seconds(row["scalar_rgb"]), seconds(row["ais_1"]), f"{row['scaling']:.2f}×"])
+                      seconds(row["scalar_rgb"]), seconds(row["ais_1"]), f"{row['scaling']:.2f}×",
+                      f"{row['busy_2']:.2f}"])
         if embree:
             lines[-1] += [seconds(row["embree_2"]),
                           f"{row['embree_ratio']:.2f}×" if row["embree_ratio"] else "—"]

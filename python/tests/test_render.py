@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 import warnings
@@ -42,6 +43,8 @@ def test_stats_come_with_the_image(cornell):
     assert stats["candidates_per_gather"] == pytest.approx(8.0)
     assert 0 < stats["traced_per_gather"] <= 8
     assert stats["render_time"] > 0
+    # Tiles render on at most the pool's threads, and some thread is always at work.
+    assert 0 < stats["threads_busy"] <= os.cpu_count() + 0.01
 
 
 def test_a_scene_renders_many_times_like_render(cornell):

@@ -306,7 +306,10 @@ fn print_summary(
         world.geometry.build_time().as_secs_f64(),
         world.geometry.accelerator_name()
     );
-    println!("render time  {seconds:.3} s");
+    println!(
+        "render time  {seconds:.3} s ({:.2} threads busy on average)",
+        output.busy.as_secs_f64() / seconds.max(1e-9)
+    );
     println!(
         "rays         {} camera + {} occlusion = {:.2} M rays/s",
         output.rays.closest_hit,

@@ -60,6 +60,14 @@ fn thread_independent(world: &World, settings: GatherSettings) -> RenderOutput<G
     let two = on_threads(world, 2, Integrator::Gather(settings));
     assert_eq!(bits(&one.image), bits(&two.image), "{settings:?}");
     assert_eq!(one.stats.ais, two.stats.ais, "{settings:?}");
+    // The threads' summed time on tiles: some, and no more than the pool could give.
+    for (output, threads) in [(&one, 1.0), (&two, 2.0)] {
+        let (busy, time) = (output.busy.as_secs_f64(), output.time.as_secs_f64());
+        assert!(
+            busy > 0.0 && busy <= threads * time,
+            "{busy} s busy in {time} s"
+        );
+    }
     one
 }
 

@@ -72,6 +72,10 @@ pub struct RenderOutput<S> {
     pub work_per_sample: Vec<f32>,
     /// Wall time of the render loop.
     pub time: Duration,
+    /// Time the threads spent rendering tiles, summed over them: over [`RenderOutput::time`],
+    /// how many threads were busy on average (short of the thread count where threads
+    /// waited for the last tiles of a pass).
+    pub busy: Duration,
 }
 
 impl<S> RenderOutput<S> {
@@ -84,6 +88,7 @@ impl<S> RenderOutput<S> {
             stats: f(self.stats),
             work_per_sample: self.work_per_sample,
             time: self.time,
+            busy: self.busy,
         }
     }
 }
@@ -105,6 +110,8 @@ struct TileResult<S, O> {
     counts: RayCounts,
     stats: S,
     observed: O,
+    /// How long the tile took.
+    took: Duration,
 }
 
 /// One pass of a render.
@@ -184,6 +191,7 @@ fn render_passes<I: SampleIntegrator>(
     let mut passes = integrator.passes(world, settings.first_sample, settings.samples_per_pixel);
     let progress = progress_bar(rects.len() * passes.len(), settings.progress);
     let started = Instant::now();
+    let mut busy = Duration::ZERO;
     let mut output = Accumulated::<<I::Tile as TileState>::Stats>::new(region, rendered);
     let mut index = 0;
     while index < passes.len() {
@@ -215,6 +223,7 @@ fn render_passes<I: SampleIntegrator>(
             })
             .collect();
         for result in results {
+            busy += result.took;
             learned.merge(output.add(result, samples, settings.samples_per_pixel));
         }
         learned.end_pass(PassEnd {
@@ -238,6 +247,7 @@ fn render_passes<I: SampleIntegrator>(
         stats: output.stats,
         work_per_sample: output.work_per_sample,
         time: started.elapsed(),
+        busy,
     }
 }
 
@@ -310,6 +320,7 @@ fn render_tile<I: SampleIntegrator>(
     pass: Pass,
     tile: &Tile,
 ) -> TileResult<<I::Tile as TileState>::Stats, <I::Tile as TileState>::Observed> {
+    let started = Instant::now();
     let mut counts = RayCounts::default();
     let mut state = integrator.begin_tile(world, tile, learned, &mut counts);
     let (width, height) = tile.image;
@@ -361,5 +372,6 @@ fn render_tile<I: SampleIntegrator>(
         counts,
         stats: state.finish(),
         observed,
+        took: started.elapsed(),
     }
 }
