@@ -308,7 +308,7 @@ fn print_summary(
     );
     println!(
         "render time  {seconds:.3} s ({:.2} threads busy on average)",
-        output.busy.as_secs_f64() / seconds.max(1e-9)
+        output.threads_busy()
     );
     println!(
         "rays         {} camera + {} occlusion = {:.2} M rays/s",

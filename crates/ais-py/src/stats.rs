@@ -17,10 +17,7 @@ pub fn stats_dict<'py>(
     let ais = &output.stats.ais;
     let gathers = ais.batches.max(1) as f64;
     dict.set_item("render_time", seconds)?;
-    dict.set_item(
-        "threads_busy",
-        output.busy.as_secs_f64() / seconds.max(1e-9),
-    )?;
+    dict.set_item("threads_busy", output.threads_busy())?;
     dict.set_item("spp", samples_per_pixel)?;
     dict.set_item("camera_rays", output.rays.closest_hit)?;
     dict.set_item("occlusion_rays", output.rays.occlusion)?;

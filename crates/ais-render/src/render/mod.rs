@@ -79,6 +79,12 @@ pub struct RenderOutput<S> {
 }
 
 impl<S> RenderOutput<S> {
+    /// How many threads were rendering tiles on average over the render ([`RenderOutput::busy`]
+    /// over [`RenderOutput::time`]).
+    pub fn threads_busy(&self) -> f64 {
+        self.busy.as_secs_f64() / self.time.as_secs_f64().max(1e-9)
+    }
+
     /// The same render with its statistics turned into `T` (e.g. a study's own).
     pub fn map_stats<T>(self, f: impl FnOnce(S) -> T) -> RenderOutput<T> {
         RenderOutput {
