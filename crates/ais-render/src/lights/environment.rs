@@ -134,8 +134,8 @@ impl EnvironmentMap {
 
     /// Where `direction` (unit, world space) falls: Mitsuba's u = atan2(x, −z) / 2π ∈ [0, 1)
     /// and v = acos(y) / π ∈ [0, 1] in the emitter's frame, and the sampling cell there.
-    #[inline]
-    pub(super) fn locate(&self, direction: Vec3) -> MapLocation {
+    #[inline(always)]
+    pub(crate) fn locate(&self, direction: Vec3) -> MapLocation {
         let d = self.to_local * direction;
         let mut u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI32);
         if u < 0.0 {

@@ -20,7 +20,7 @@ mod toward;
 pub use area::{AreaHit, AreaLight, AreaSample, AreaShape, LightSpot};
 pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use draw::Draw;
-pub use environment::{luminance, Environment, EnvironmentMap};
+pub use environment::{luminance, Environment, EnvironmentMap, MapLocation};
 pub use environment_draws::EnvironmentDraws;
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout};
 pub use mesh_emitter::MeshEmitter;
@@ -166,6 +166,11 @@ impl Lights {
     /// The environment's index in the choice of a light.
     fn environment_index(&self) -> usize {
         self.area.len() + self.delta.len()
+    }
+
+    /// Probability of choosing the environment for `receiver`.
+    pub(crate) fn environment_choice(&self, receiver: &Receiver) -> f64 {
+        self.choice_probability(receiver, self.environment_index())
     }
 
     /// Whether the scene has no emitter at all.

@@ -128,6 +128,11 @@ impl Toward {
         self.is_delta() || self.specular.is_some()
     }
 
+    /// Its place on the environment map, if located.
+    pub(crate) fn map_location(&self) -> Option<MapLocation> {
+        self.on_map
+    }
+
     /// Its place on `map` (a scene has one environment), located on first use.
     #[inline]
     pub(super) fn location(&mut self, map: &EnvironmentMap) -> MapLocation {

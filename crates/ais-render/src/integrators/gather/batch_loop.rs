@@ -2,6 +2,7 @@
 //! driver, traced and recorded. The host loop of the `ais` library, written for this
 //! renderer.
 
+use super::environment_only::EnvironmentOnly;
 use super::gather_sizes::CandidateSpread;
 use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
@@ -216,37 +217,80 @@ fn trace_run(
 /// traced and added up in runs of [`AHEAD`] as [`run_ahead`] does, but with no call into
 /// the driver per candidate. The same estimate and counts, to the bit. Each candidate's
 /// value goes to `spread` where given.
+/// A batch lit by an environment map alone, on a diffuse surface, takes the shortcut of
+/// [`EnvironmentOnly`]: the same estimate.
 fn run_plain(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
     counts: &mut RayCounts,
-    mut spread: Option<&mut CandidateSpread>,
+    spread: Option<&mut CandidateSpread>,
 ) -> ais::Estimate<[f32; 3]> {
-    let mut sum = [0.0; 3];
-    let mut tally = PlainTally::default();
+    let mut total = PlainSum {
+        spread,
+        ..PlainSum::default()
+    };
+    let numbers = batch.begin_plain(run.rays, run.seed);
+    match EnvironmentOnly::of(run) {
+        Some(shortcut) => shortcut.run(run, numbers, counts, &mut total),
+        None => add_up_plain(run, numbers, counts, &mut total),
+    }
+    batch.finish_plain(total.sum, total.tally)
+}
+
+/// The general runs of [`run_plain`]: `numbers`' candidates drawn, traced and added up
+/// into `total`.
+pub(super) fn add_up_plain(
+    run: &BatchRun,
+    numbers: &[[f32; 2]],
+    counts: &mut RayCounts,
+    total: &mut PlainSum,
+) {
     let mut drawn = [None; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
     let mut origin = SharedOrigin::default();
-    for numbers in batch.begin_plain(run.rays, run.seed).chunks(AHEAD) {
+    for numbers in numbers.chunks(AHEAD) {
         let drawn = &mut drawn[..numbers.len()];
         draw_into(run, numbers, drawn);
         let kept = keep_in_support(run.at, drawn);
-        tally.outside_support += (numbers.len() - kept) as u32;
-        tally.traced += kept as u32;
+        total.count_run(numbers.len(), kept);
         let shadow_rays = ShadowRays {
             counts,
             origin: &mut origin,
         };
         trace_run(run, drawn, &mut arriving, shadow_rays);
         for (toward, &arriving) in drawn.iter_mut().flatten().zip(&arriving) {
-            let value = plain_value_of(run, toward, arriving);
-            sum = Value::add(sum, value.to_array());
-            if let Some(spread) = spread.as_deref_mut() {
-                spread.add(luminance(value) as f64);
-            }
+            total.add(plain_value_of(run, toward, arriving));
         }
     }
-    batch.finish_plain(sum, tally)
+}
+
+/// What a plain batch adds up: its traced candidates' values, how many it traced, and
+/// each value for the gather's spread where one is kept.
+#[derive(Default)]
+pub(super) struct PlainSum<'s> {
+    /// The sum of the values.
+    pub sum: [f32; 3],
+    /// The candidates traced and not.
+    pub tally: PlainTally,
+    /// The gather's spread, given every value.
+    pub spread: Option<&'s mut CandidateSpread>,
+}
+
+impl PlainSum<'_> {
+    /// A run of `candidates` of which `kept` lie inside the support (and are traced).
+    pub fn count_run(&mut self, candidates: usize, kept: usize) {
+        self.tally.outside_support += (candidates - kept) as u32;
+        self.tally.traced += kept as u32;
+    }
+
+    /// A traced candidate's value (zero if its ray was blocked).
+    #[inline]
+    pub fn add(&mut self, value: Vec3) {
+        self.sum = Value::add(self.sum, value.to_array());
+        if let Some(spread) = self.spread.as_deref_mut() {
+            spread.add(luminance(value) as f64);
+        }
+    }
 }
 
 /// Empties the slots of `drawn` whose candidates lie outside the support (not carried by

@@ -57,6 +57,11 @@ impl<'a> CandidateSampler<'a> {
         }
     }
 
+    /// The strategy, when nothing is mixed with it.
+    pub fn unguided(&self) -> Option<Strategy> {
+        self.guide.is_none().then_some(self.strategy)
+    }
+
     /// A candidate direction from `u` ∈ [0, 1)² (`None`: the strategy gave none).
     #[inline]
     pub fn sample_direction(&self, at: &GatherPoint, u: [f32; 2]) -> Option<Toward> {

@@ -15,6 +15,7 @@
 
 pub mod acceptance;
 pub mod batch_loop;
+mod environment_only;
 pub mod field;
 pub mod field_guide;
 pub mod gather_sizes;

@@ -1,0 +1,258 @@
+//! AIS off's batch where an environment map is the only light, the surface is diffuse and
+//! MIS draws the candidates: the estimate of the general runs ([`super::batch_loop`]) to
+//! the bit, without their per-candidate bookkeeping (a candidate's [`Toward`], the dispatch
+//! over kinds of draws and lights, the search for an emitter along a BSDF-drawn
+//! direction). In scenes lit by a sky that bookkeeping was about a tenth of the frame.
+//!
+//! [`Toward`]: crate::lights::Toward
+
+use super::batch_loop::{BatchRun, PlainSum};
+use super::strategy::{MisParts, Strategy};
+use crate::bsdf::{diffuse_direction, ShadingFrame};
+use crate::geometry::{spawn_ray, RecentBlockers};
+use crate::lights::{Draw, Environment, EnvironmentDraws, EnvironmentMap, MapLocation};
+use crate::render::RayCounts;
+use glam::Vec3;
+
+/// How many candidates are drawn, traced and added up together.
+const RUN: usize = 16;
+
+/// What an environment-only batch needs of its scene and gather point.
+pub(super) struct EnvironmentOnly<'a> {
+    /// The only light.
+    map: &'a EnvironmentMap,
+    /// The diffuse material's frame (its BSDF draws).
+    frame: ShadingFrame,
+    /// MIS's BSDF share.
+    share: f64,
+    /// The probability that light sampling chooses the environment.
+    choice: f64,
+}
+
+/// The candidates of one run, lane by lane.
+struct Lanes {
+    /// Each candidate's direction.
+    direction: [Vec3; RUN],
+    /// Where a candidate drawn from the map falls on it (`None`: drawn from the BSDF, to be
+    /// located if its ray is free).
+    location: [Option<MapLocation>; RUN],
+    /// Whether a direction was drawn and lies inside the BSDF's support.
+    kept: [bool; RUN],
+    /// Whether its shadow ray is free.
+    free: [bool; RUN],
+}
+
+impl<'a> EnvironmentOnly<'a> {
+    /// The batch's shortcut, where it applies: an unguided MIS proposal, an environment map
+    /// as the only light (chosen by power), a single diffuse material.
+    pub(super) fn of(run: &BatchRun<'a>) -> Option<Self> {
+        let at = run.at;
+        let lights = at.lights;
+        let only_the_map = lights.area.is_empty()
+            && lights.delta.is_empty()
+            && at.receiver.environment_guide.is_none()
+            && at.receiver.light_choice.is_none();
+        if run.sampler.unguided() != Some(Strategy::Mis) || !only_the_map {
+            return None;
+        }
+        let Some(Environment::Map(map)) = &lights.environment else {
+            return None;
+        };
+        Some(EnvironmentOnly {
+            map,
+            frame: *at.bsdf.diffuse_frame()?,
+            share: at.mis_bsdf_share,
+            choice: lights.environment_choice(&at.receiver),
+        })
+    }
+
+    /// Draws, traces and adds up the candidates of `numbers` (the batch's, from
+    /// [`ais::Batch::begin_plain`]) into `total`.
+    pub(super) fn run(
+        &self,
+        run: &BatchRun,
+        numbers: &[[f32; 2]],
+        counts: &mut RayCounts,
+        total: &mut PlainSum,
+    ) {
+        let mut blockers = RecentBlockers::default();
+        let mut lanes = Lanes {
+            direction: [Vec3::ZERO; RUN],
+            location: [None; RUN],
+            kept: [false; RUN],
+            free: [false; RUN],
+        };
+        for numbers in numbers.chunks(RUN) {
+            let count = numbers.len();
+            self.draw(run, numbers, &mut lanes);
+            let kept = lanes.kept[..count].iter().filter(|&&kept| kept).count();
+            total.count_run(count, kept);
+            for k in 0..count {
+                lanes.free[k] = lanes.kept[k] && {
+                    counts.occlusion += 1;
+                    let at = run.at;
+                    let ray = spawn_ray(at.receiver.point, at.frame.geometric, lanes.direction[k]);
+                    !run.world.geometry.occluded_after(&ray, &mut blockers)
+                };
+            }
+            // All the lookups after all the rays, so that they overlap. A blocked candidate
+            // adds its zero, as in the general runs (the gather's spread counts it).
+            for k in (0..count).filter(|&k| lanes.kept[k]) {
+                let free = lanes.free[k];
+                total.add(match free {
+                    true => self.brought(run, lanes.direction[k], lanes.location[k]),
+                    false => Vec3::ZERO,
+                });
+            }
+        }
+    }
+
+    /// Draws the candidates of `numbers` into `lanes`: the BSDF's, then the map's all
+    /// together ([`EnvironmentDraws`]), and which lie inside the support.
+    fn draw(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
+        let at = run.at;
+        let w = self.share as f32;
+        let mut environment = EnvironmentDraws::default();
+        let mut drawn = [false; RUN];
+        for (k, &u) in numbers.iter().enumerate() {
+            // The split of `Strategy::begin_direction`'s MIS, number for number.
+            if u[0] < w {
+                lanes.direction[k] = diffuse_direction(&self.frame, [u[0] / w, u[1]]);
+                lanes.location[k] = None;
+                drawn[k] = true;
+                continue;
+            }
+            let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
+            match at.lights.begin_sample(&at.receiver, [u0, u[1]]) {
+                Draw::Environment(u) => environment.push(k, u),
+                Draw::Made(toward) => {
+                    if let Some(toward) = toward {
+                        (lanes.direction[k], lanes.location[k]) =
+                            (toward.direction, toward.map_location());
+                        drawn[k] = true;
+                    }
+                }
+                Draw::Rectangle(_) => unreachable!("no area light lights this scene"),
+            }
+        }
+        environment.draw(at.lights, &at.receiver, |k, toward| {
+            (lanes.direction[k], lanes.location[k]) = (toward.direction, toward.map_location());
+            drawn[k] = true;
+        });
+        for (k, &drawn) in drawn[..numbers.len()].iter().enumerate() {
+            lanes.kept[k] = drawn && at.bsdf.in_support(at.wo, lanes.direction[k]);
+        }
+    }
+
+    /// What a candidate whose ray is free brings (f·L/p, as the general runs weigh it):
+    /// toward `direction`, at `location` on the map if it was drawn from it.
+    #[inline]
+    fn brought(&self, run: &BatchRun, direction: Vec3, location: Option<MapLocation>) -> Vec3 {
+        let at = run.at;
+        let location = location.unwrap_or_else(|| self.map.locate(direction));
+        let radiance = self.map.radiance_at(location);
+        let pdf = MisParts {
+            bsdf: at.bsdf.pdf(at.wo, direction),
+            light: self.choice * self.map.density_at(location) as f64,
+        }
+        .mixed(self.share);
+        if pdf <= 0.0 || radiance == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        at.bsdf.eval(at.wo, direction) * radiance / pdf as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::batch_loop::add_up_plain;
+    use super::super::gather_sizes::CandidateSpread;
+    use super::super::guiding::CandidateSampler;
+    use super::super::settings::GatherSettings;
+    use super::super::strategy::gather_point;
+    use super::*;
+    use crate::geometry::Ray;
+    use crate::image_io::{write_exr, RgbImage};
+    use crate::scene::load_scene;
+    use crate::world::World;
+    use ais::rng::Pcg32;
+    use ais::{Batch, BatchConfig, MapStart};
+
+    /// A diffuse floor with a box on it under a sky with a small sun (a map of 32 × 16
+    /// texels, rotated), in a scratch folder.
+    fn sky_over_a_box() -> World {
+        let dir = std::env::temp_dir().join(format!("ais-environment-only-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut sky = RgbImage::new(32, 16);
+        for (i, pixel) in sky.pixels.iter_mut().enumerate() {
+            let v = 0.1 + (i / 32) as f32 / 16.0 + 0.02 * (i % 32) as f32;
+            *pixel = [v, 0.9 * v, 0.7 * v];
+        }
+        sky.pixels[3 * 32 + 5] = [400.0; 3];
+        write_exr(&dir.join("sky.exr"), &sky).unwrap();
+        let xml = r#"<scene version="3.0.0">
+            <emitter type="envmap"><string name="filename" value="sky.exr"/>
+                <transform name="to_world"><rotate x="1" angle="90"/><rotate z="1" angle="30"/></transform></emitter>
+            <bsdf type="diffuse" id="grey"><rgb name="reflectance" value="0.6, 0.5, 0.4"/></bsdf>
+            <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform><ref id="grey"/></shape>
+            <shape type="cube"><transform name="to_world"><scale value="0.5"/><translate z="0.5"/></transform><ref id="grey"/></shape>
+        </scene>"#;
+        std::fs::write(dir.join("scene.xml"), xml).unwrap();
+        World::from_description(load_scene(&dir.join("scene.xml"), &[]).unwrap()).unwrap()
+    }
+
+    /// The shortcut gives the general runs' estimate, counts and spread to the bit, at
+    /// gather points on the floor and the box, lit and in the box's shadow, for several
+    /// MIS shares.
+    #[test]
+    fn the_shortcut_is_the_general_batch_to_the_bit() {
+        let world = sky_over_a_box();
+        let settings = GatherSettings::default();
+        let sampler = CandidateSampler::plain(Strategy::Mis);
+        let mut batch = Batch::<[f32; 3]>::new(BatchConfig::off()).unwrap();
+        let mut rng = Pcg32::new(5, 0);
+        let mut compared = 0;
+        for trial in 0..400u64 {
+            let target = Vec3::new(rng.next_f32() * 3.0 - 1.5, rng.next_f32() * 3.0 - 1.5, 0.0);
+            let eye = Vec3::new(2.0, -3.0, 2.5);
+            let Some(hit) = world
+                .geometry
+                .intersect(&Ray::new(eye, (target - eye).normalize()))
+            else {
+                continue;
+            };
+            let mut at = gather_point(&world, &hit, (eye - hit.point).normalize());
+            at.mis_bsdf_share = [0.5, 0.25, 0.8][trial as usize % 3];
+            let run = BatchRun {
+                world: &world,
+                settings: &settings,
+                rays: 7 + (trial % 20) as u32,
+                at: &at,
+                sampler: &sampler,
+                seed: trial,
+                start: MapStart::Empty,
+                field: None,
+                clock: None,
+            };
+            let shortcut = EnvironmentOnly::of(&run).expect("an environment-only scene");
+            let numbers = batch.begin_plain(run.rays, run.seed).to_vec();
+            let totals = [true, false].map(|short| {
+                let mut spread = CandidateSpread::default();
+                let mut counts = RayCounts::default();
+                let mut total = PlainSum {
+                    spread: Some(&mut spread),
+                    ..PlainSum::default()
+                };
+                match short {
+                    true => shortcut.run(&run, &numbers, &mut counts, &mut total),
+                    false => add_up_plain(&run, &numbers, &mut counts, &mut total),
+                }
+                let (sum, tally) = (total.sum, total.tally);
+                format!("{sum:?} {tally:?} {counts:?} {spread:?}")
+            });
+            assert_eq!(totals[0], totals[1], "gather {trial}");
+            compared += 1;
+        }
+        assert!(compared > 300, "{compared} gathers hit the scene");
+    }
+}
