@@ -86,6 +86,14 @@ pub struct MapLocation {
     cell: usize,
 }
 
+impl MapLocation {
+    /// Its sampling cell (row-major).
+    #[inline]
+    pub(super) fn cell(&self) -> usize {
+        self.cell
+    }
+}
+
 impl EnvironmentMap {
     /// An environment from a (sanitised) image already multiplied by the emitter's `scale`,
     /// and the rotation part of its `to_world`. A one-row image is treated as two equal rows.

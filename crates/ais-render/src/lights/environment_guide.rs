@@ -13,7 +13,7 @@
 //! candidate.
 
 use super::ONE_BELOW;
-use super::{Environment, EnvironmentMap, Toward};
+use super::{Environment, EnvironmentMap, MapLocation, Toward};
 use ais::field::octahedral;
 use ais::mapping::LatLong;
 use ais::sampling::{cumulative, guide_table, invert_guided};
@@ -402,9 +402,39 @@ impl EnvironmentGuide {
         &self.partition
     }
 
+    /// Its weights per place on an environment map, where its texels hold the map's cells
+    /// (`None`: they split them).
+    pub fn map_weights(&self) -> Option<MapWeights<'_>> {
+        match &self.partition.contents {
+            TexelContents::Cells { cell_texel, .. } => Some(MapWeights {
+                guide: self,
+                cell_texel,
+            }),
+            _ => None,
+        }
+    }
+
     /// The mixture's density at a direction (solid angle).
     pub fn pdf(&self, environment: &Environment, toward: &mut Toward) -> f64 {
         let (density, texel) = self.partition.density_and_texel(environment, toward);
         density * self.mixture_weight(texel)
+    }
+}
+
+/// What an environment guide whose texels hold whole cells multiplies the map's own
+/// density by, place by place ([`EnvironmentGuide::map_weights`]).
+#[derive(Clone, Copy, Debug)]
+pub struct MapWeights<'g> {
+    guide: &'g EnvironmentGuide,
+    cell_texel: &'g [u32],
+}
+
+impl MapWeights<'_> {
+    /// The mixture's weight at `location`: its density there is the map's times this
+    /// ([`EnvironmentGuide::pdf`], to the bit).
+    #[inline]
+    pub fn at(&self, location: MapLocation) -> f64 {
+        self.guide
+            .mixture_weight(self.cell_texel[location.cell()] as usize)
     }
 }

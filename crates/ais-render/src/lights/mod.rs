@@ -22,7 +22,7 @@ pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use draw::Draw;
 pub use environment::{luminance, Environment, EnvironmentMap, MapLocation};
 pub use environment_draws::EnvironmentDraws;
-pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout};
+pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout, MapWeights};
 pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
 pub use rectangle_draws::{AreaChoice, RectangleDraw, RectangleDraws};

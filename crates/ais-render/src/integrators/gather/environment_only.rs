@@ -1,5 +1,5 @@
-//! AIS off's batch where an environment map is the only light, the surface is diffuse and
-//! MIS draws the candidates: the estimate of the general runs ([`super::batch_loop`]) to
+//! AIS off's batch where an environment map is the only light (drawn from its own density
+//! or its product with a guide), the surface is diffuse and MIS draws the candidates: the estimate of the general runs ([`super::batch_loop`]) to
 //! the bit, without their per-candidate bookkeeping (a candidate's [`Toward`], the dispatch
 //! over kinds of draws and lights, the search for an emitter along a BSDF-drawn
 //! direction). In scenes lit by a sky that bookkeeping was about a tenth of the frame.
@@ -10,7 +10,7 @@ use super::batch_loop::{BatchRun, PlainSum};
 use super::strategy::{MisParts, Strategy};
 use crate::bsdf::{diffuse_direction, ShadingFrame};
 use crate::geometry::{spawn_ray, RecentBlockers};
-use crate::lights::{Draw, Environment, EnvironmentDraws, EnvironmentMap, MapLocation};
+use crate::lights::{Draw, Environment, EnvironmentDraws, EnvironmentMap, MapLocation, MapWeights};
 use crate::render::RayCounts;
 use glam::Vec3;
 
@@ -27,6 +27,9 @@ pub(super) struct EnvironmentOnly<'a> {
     share: f64,
     /// The probability that light sampling chooses the environment.
     choice: f64,
+    /// The guide's weights over the map's own density, when light sampling draws from
+    /// the map's product with a guide.
+    guide: Option<MapWeights<'a>>,
 }
 
 /// The candidates of one run, lane by lane.
@@ -44,22 +47,27 @@ struct Lanes {
 
 impl<'a> EnvironmentOnly<'a> {
     /// The batch's shortcut, where it applies: an unguided MIS proposal, an environment map
-    /// as the only light (chosen by power), a single diffuse material.
+    /// as the only light (chosen by power; drawn from its own density or from a guide whose
+    /// texels hold its cells), a single diffuse material.
     pub(super) fn of(run: &BatchRun<'a>) -> Option<Self> {
         let at = run.at;
         let lights = at.lights;
-        let only_the_map = lights.area.is_empty()
-            && lights.delta.is_empty()
-            && at.receiver.environment_guide.is_none()
-            && at.receiver.light_choice.is_none();
+        let only_the_map =
+            lights.area.is_empty() && lights.delta.is_empty() && at.receiver.light_choice.is_none();
         if run.sampler.unguided() != Some(Strategy::Mis) || !only_the_map {
             return None;
         }
         let Some(Environment::Map(map)) = &lights.environment else {
             return None;
         };
+        // A guide whose texels split the map's cells has no per-cell weight.
+        let guide = match at.receiver.environment_guide {
+            Some(guide) => Some(guide.map_weights()?),
+            None => None,
+        };
         Some(EnvironmentOnly {
             map,
+            guide,
             frame: *at.bsdf.diffuse_frame()?,
             share: at.mis_bsdf_share,
             choice: lights.environment_choice(&at.receiver),
@@ -150,10 +158,12 @@ impl<'a> EnvironmentOnly<'a> {
     fn brought(&self, run: &BatchRun, direction: Vec3, location: Option<MapLocation>) -> Vec3 {
         let at = run.at;
         let location = location.unwrap_or_else(|| self.map.locate(direction));
+        let guided = self.guide.map_or(1.0, |weights| weights.at(location));
         let radiance = self.map.radiance_at(location);
         let pdf = MisParts {
             bsdf: at.bsdf.pdf(at.wo, direction),
-            light: self.choice * self.map.density_at(location) as f64,
+            // (× 1 unguided: the same bits as the map's density alone.)
+            light: self.choice * (self.map.density_at(location) as f64 * guided),
         }
         .mixed(self.share);
         if pdf <= 0.0 || radiance == Vec3::ZERO {
@@ -173,6 +183,7 @@ mod tests {
     use super::*;
     use crate::geometry::Ray;
     use crate::image_io::{write_exr, RgbImage};
+    use crate::lights::{EnvironmentGuide, GuideLayout};
     use crate::scene::load_scene;
     use crate::world::World;
     use ais::rng::Pcg32;
@@ -203,10 +214,21 @@ mod tests {
 
     /// The shortcut gives the general runs' estimate, counts and spread to the bit, at
     /// gather points on the floor and the box, lit and in the box's shadow, for several
-    /// MIS shares.
+    /// MIS shares, with the map drawn from its own density and from a guide's product
+    /// (alone and mixed).
     #[test]
     fn the_shortcut_is_the_general_batch_to_the_bit() {
         let world = sky_over_a_box();
+        let Some(Environment::Map(map)) = &world.lights.environment else {
+            unreachable!("the scene has a map")
+        };
+        let mut guides = [1.0, 0.5].map(|fraction| {
+            let mut guide = EnvironmentGuide::new(map.partition(GuideLayout::Octahedral(8)));
+            guide.set_affinities(|t| 0.01 + ((t * 5) % 7) as f32);
+            guide.set_fraction(fraction);
+            guide
+        });
+        guides[1].set_affinities(|t| (t % 3) as f32);
         let settings = GatherSettings::default();
         let sampler = CandidateSampler::plain(Strategy::Mis);
         let mut batch = Batch::<[f32; 3]>::new(BatchConfig::off()).unwrap();
@@ -223,6 +245,8 @@ mod tests {
             };
             let mut at = gather_point(&world, &hit, (eye - hit.point).normalize());
             at.mis_bsdf_share = [0.5, 0.25, 0.8][trial as usize % 3];
+            at.receiver.environment_guide =
+                [None, Some(&guides[0]), Some(&guides[1])][(trial / 3) as usize % 3];
             let run = BatchRun {
                 world: &world,
                 settings: &settings,
