@@ -1,5 +1,6 @@
-//! AIS off's batch where an environment map is the only light (drawn from its own density
-//! or its product with a guide), the surface is diffuse and MIS draws the candidates: the estimate of the general runs ([`super::batch_loop`]) to
+//! A plain batch (AIS off's, or a guided one of `auto`'s) where an environment map is the
+//! only light (drawn from its own density or its product with a guide) and MIS draws the
+//! candidates: the estimate of the general runs ([`super::batch_loop`]) to
 //! the bit, without their per-candidate bookkeeping (a candidate's [`Toward`], the dispatch
 //! over kinds of draws and lights, the search for an emitter along a BSDF-drawn
 //! direction). In scenes lit by a sky that bookkeeping was about a tenth of the frame.
@@ -8,7 +9,7 @@
 
 use super::batch_loop::{BatchRun, PlainSum};
 use super::strategy::{MisParts, Strategy};
-use crate::bsdf::{diffuse_direction, ShadingFrame};
+use crate::bsdf::{diffuse_direction, ShadingFrame, SpecularMass};
 use crate::geometry::{spawn_ray, RecentBlockers};
 use crate::lights::{Draw, Environment, EnvironmentDraws, EnvironmentMap, MapLocation, MapWeights};
 use crate::render::RayCounts;
@@ -21,8 +22,6 @@ const RUN: usize = 16;
 pub(super) struct EnvironmentOnly<'a> {
     /// The only light.
     map: &'a EnvironmentMap,
-    /// The diffuse material's frame (its BSDF draws).
-    frame: ShadingFrame,
     /// MIS's BSDF share.
     share: f64,
     /// The probability that light sampling chooses the environment.
@@ -30,6 +29,9 @@ pub(super) struct EnvironmentOnly<'a> {
     /// The guide's weights over the map's own density, when light sampling draws from
     /// the map's product with a guide.
     guide: Option<MapWeights<'a>>,
+    /// A single diffuse material's frame, whose draws are made here (other BSDFs are asked
+    /// for theirs).
+    diffuse: Option<ShadingFrame>,
 }
 
 /// The candidates of one run, lane by lane.
@@ -43,12 +45,14 @@ struct Lanes {
     kept: [bool; RUN],
     /// Whether its shadow ray is free.
     free: [bool; RUN],
+    /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
+    specular: [Option<SpecularMass>; RUN],
 }
 
 impl<'a> EnvironmentOnly<'a> {
-    /// The batch's shortcut, where it applies: an unguided MIS proposal, an environment map
-    /// as the only light (chosen by power; drawn from its own density or from a guide whose
-    /// texels hold its cells), a single diffuse material.
+    /// The batch's shortcut, where it applies: an unguided MIS proposal, and an environment
+    /// map as the only light (chosen by power; drawn from its own density or from a guide
+    /// whose texels hold its cells). Any BSDF: its own draws and densities are asked of it.
     pub(super) fn of(run: &BatchRun<'a>) -> Option<Self> {
         let at = run.at;
         let lights = at.lights;
@@ -68,7 +72,7 @@ impl<'a> EnvironmentOnly<'a> {
         Some(EnvironmentOnly {
             map,
             guide,
-            frame: *at.bsdf.diffuse_frame()?,
+            diffuse: at.bsdf.diffuse_frame().copied(),
             share: at.mis_bsdf_share,
             choice: lights.environment_choice(&at.receiver),
         })
@@ -89,6 +93,7 @@ impl<'a> EnvironmentOnly<'a> {
             location: [None; RUN],
             kept: [false; RUN],
             free: [false; RUN],
+            specular: [None; RUN],
         };
         for numbers in numbers.chunks(RUN) {
             let count = numbers.len();
@@ -108,26 +113,39 @@ impl<'a> EnvironmentOnly<'a> {
             for k in (0..count).filter(|&k| lanes.kept[k]) {
                 let free = lanes.free[k];
                 total.add(match free {
-                    true => self.brought(run, lanes.direction[k], lanes.location[k]),
+                    true => self.brought(run, &lanes, k),
                     false => Vec3::ZERO,
                 });
             }
         }
     }
 
-    /// Draws the candidates of `numbers` into `lanes`: the BSDF's, then the map's all
-    /// together ([`EnvironmentDraws`]), and which lie inside the support.
+    /// Draws the candidates of `numbers` into `lanes`: the map's all together
+    /// ([`EnvironmentDraws`]), then the BSDF's ([`GatherPoint::draw_bsdf_run`]), and which
+    /// carry light to the viewer ([`GatherPoint::carries`]).
+    ///
+    /// [`GatherPoint::draw_bsdf_run`]: super::strategy::GatherPoint::draw_bsdf_run
+    /// [`GatherPoint::carries`]: super::strategy::GatherPoint::carries
     fn draw(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
         let at = run.at;
         let w = self.share as f32;
         let mut environment = EnvironmentDraws::default();
+        let mut bsdf_numbers = [[0.0; 2]; RUN];
+        let mut bsdf_slots = [0; RUN];
+        let mut bsdf_draws = 0;
         let mut drawn = [false; RUN];
         for (k, &u) in numbers.iter().enumerate() {
+            lanes.location[k] = None;
+            lanes.specular[k] = None;
             // The split of `Strategy::begin_direction`'s MIS, number for number.
             if u[0] < w {
-                lanes.direction[k] = diffuse_direction(&self.frame, [u[0] / w, u[1]]);
-                lanes.location[k] = None;
-                drawn[k] = true;
+                let u = [u[0] / w, u[1]];
+                if let Some(frame) = &self.diffuse {
+                    (lanes.direction[k], drawn[k]) = (diffuse_direction(frame, u), true);
+                } else {
+                    (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
+                    bsdf_draws += 1;
+                }
                 continue;
             }
             let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
@@ -147,29 +165,43 @@ impl<'a> EnvironmentOnly<'a> {
             (lanes.direction[k], lanes.location[k]) = (toward.direction, toward.map_location());
             drawn[k] = true;
         });
+        at.draw_bsdf_run(&bsdf_numbers[..bsdf_draws], |i, toward| {
+            let k = bsdf_slots[i];
+            if let Some(toward) = toward {
+                (lanes.direction[k], lanes.specular[k]) = (toward.direction, toward.specular);
+                drawn[k] = true;
+            }
+        });
         for (k, &drawn) in drawn[..numbers.len()].iter().enumerate() {
-            lanes.kept[k] = drawn && at.bsdf.in_support(at.wo, lanes.direction[k]);
+            lanes.kept[k] = drawn
+                && (lanes.specular[k].is_some() || at.bsdf.in_support(at.wo, lanes.direction[k]));
         }
     }
 
-    /// What a candidate whose ray is free brings (f·L/p, as the general runs weigh it):
-    /// toward `direction`, at `location` on the map if it was drawn from it.
+    /// What candidate `k` of `lanes`, whose ray is free, brings (f·L/p, as the general runs
+    /// weigh it: along a specular lobe, its mass over the probability of picking it).
     #[inline]
-    fn brought(&self, run: &BatchRun, direction: Vec3, location: Option<MapLocation>) -> Vec3 {
+    fn brought(&self, run: &BatchRun, lanes: &Lanes, k: usize) -> Vec3 {
         let at = run.at;
-        let location = location.unwrap_or_else(|| self.map.locate(direction));
-        let guided = self.guide.map_or(1.0, |weights| weights.at(location));
+        let direction = lanes.direction[k];
+        let location = lanes.location[k].unwrap_or_else(|| self.map.locate(direction));
         let radiance = self.map.radiance_at(location);
-        let pdf = MisParts {
-            bsdf: at.bsdf.pdf(at.wo, direction),
-            // (× 1 unguided: the same bits as the map's density alone.)
-            light: self.choice * (self.map.density_at(location) as f64 * guided),
-        }
-        .mixed(self.share);
+        let (scattering, pdf) = match lanes.specular[k] {
+            Some(mass) => (mass.weight, self.share * mass.probability as f64),
+            None => {
+                let guided = self.guide.map_or(1.0, |weights| weights.at(location));
+                let parts = MisParts {
+                    bsdf: at.bsdf.pdf(at.wo, direction),
+                    // (× 1 unguided: the same bits as the map's density alone.)
+                    light: self.choice * (self.map.density_at(location) as f64 * guided),
+                };
+                (at.bsdf.eval(at.wo, direction), parts.mixed(self.share))
+            }
+        };
         if pdf <= 0.0 || radiance == Vec3::ZERO {
             return Vec3::ZERO;
         }
-        at.bsdf.eval(at.wo, direction) * radiance / pdf as f32
+        scattering * radiance / pdf as f32
     }
 }
 
@@ -189,8 +221,8 @@ mod tests {
     use ais::rng::Pcg32;
     use ais::{Batch, BatchConfig, MapStart};
 
-    /// A diffuse floor with a box on it under a sky with a small sun (a map of 32 × 16
-    /// texels, rotated), in a scratch folder.
+    /// A diffuse floor with a smooth plastic box and a rough metal ball on it under a sky
+    /// with a small sun (a map of 32 × 16 texels, rotated), in a scratch folder.
     fn sky_over_a_box() -> World {
         let dir = std::env::temp_dir().join(format!("ais-environment-only-{}", std::process::id()));
         std::fs::create_dir_all(&dir).unwrap();
@@ -206,14 +238,17 @@ mod tests {
                 <transform name="to_world"><rotate x="1" angle="90"/><rotate z="1" angle="30"/></transform></emitter>
             <bsdf type="diffuse" id="grey"><rgb name="reflectance" value="0.6, 0.5, 0.4"/></bsdf>
             <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform><ref id="grey"/></shape>
-            <shape type="cube"><transform name="to_world"><scale value="0.5"/><translate z="0.5"/></transform><ref id="grey"/></shape>
+            <shape type="cube"><transform name="to_world"><scale value="0.5"/><translate z="0.5"/></transform>
+                <bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.2, 0.4, 0.6"/></bsdf></shape>
+            <shape type="sphere"><point name="center" x="-1" y="0.8" z="0.4"/><float name="radius" value="0.4"/>
+                <bsdf type="roughconductor"><float name="alpha" value="0.2"/></bsdf></shape>
         </scene>"#;
         std::fs::write(dir.join("scene.xml"), xml).unwrap();
         World::from_description(load_scene(&dir.join("scene.xml"), &[]).unwrap()).unwrap()
     }
 
     /// The shortcut gives the general runs' estimate, counts and spread to the bit, at
-    /// gather points on the floor and the box, lit and in the box's shadow, for several
+    /// gather points on the floor, the box and the ball, lit and in shadow, for several
     /// MIS shares, with the map drawn from its own density and from a guide's product
     /// (alone and mixed).
     #[test]
