@@ -8,7 +8,7 @@
 //! [`Toward`]: crate::lights::Toward
 
 use super::batch_loop::{BatchRun, PlainSum};
-use super::strategy::{MisParts, Strategy};
+use super::strategy::{MisParts, MisPick, Strategy};
 use crate::bsdf::{diffuse_direction, ShadingFrame, SpecularMass};
 use crate::geometry::{spawn_ray, RecentBlockers};
 use crate::lights::{Draw, Environment, EnvironmentDraws, EnvironmentMap, MapLocation, MapWeights};
@@ -128,7 +128,6 @@ impl<'a> EnvironmentOnly<'a> {
     /// [`GatherPoint::carries`]: super::strategy::GatherPoint::carries
     fn draw(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
         let at = run.at;
-        let w = self.share as f32;
         let mut environment = EnvironmentDraws::default();
         let mut bsdf_numbers = [[0.0; 2]; RUN];
         let mut bsdf_slots = [0; RUN];
@@ -137,19 +136,19 @@ impl<'a> EnvironmentOnly<'a> {
         for (k, &u) in numbers.iter().enumerate() {
             lanes.location[k] = None;
             lanes.specular[k] = None;
-            // The split of `Strategy::begin_direction`'s MIS, number for number.
-            if u[0] < w {
-                let u = [u[0] / w, u[1]];
-                if let Some(frame) = &self.diffuse {
-                    (lanes.direction[k], drawn[k]) = (diffuse_direction(frame, u), true);
-                } else {
-                    (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
-                    bsdf_draws += 1;
+            let u = match MisPick::of(self.share, u) {
+                MisPick::Bsdf(u) => {
+                    if let Some(frame) = &self.diffuse {
+                        (lanes.direction[k], drawn[k]) = (diffuse_direction(frame, u), true);
+                    } else {
+                        (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
+                        bsdf_draws += 1;
+                    }
+                    continue;
                 }
-                continue;
-            }
-            let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
-            match at.lights.begin_sample(&at.receiver, [u0, u[1]]) {
+                MisPick::Light(u) => u,
+            };
+            match at.lights.begin_sample(&at.receiver, u) {
                 Draw::Environment(u) => environment.push(k, u),
                 Draw::Made(toward) => {
                     if let Some(toward) = toward {

@@ -244,15 +244,10 @@ impl Strategy {
             Strategy::Uniform => CandidateDraw::Made(Some(Toward::new(uniform_sphere(u)))),
             Strategy::Bsdf => CandidateDraw::Bsdf(u),
             Strategy::Light => at.lights.begin_sample(&at.receiver, u).into(),
-            Strategy::Mis => {
-                let w = at.mis_bsdf_share as f32;
-                if u[0] < w {
-                    CandidateDraw::Bsdf([u[0] / w, u[1]])
-                } else {
-                    let u0 = ((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7);
-                    at.lights.begin_sample(&at.receiver, [u0, u[1]]).into()
-                }
-            }
+            Strategy::Mis => match MisPick::of(at.mis_bsdf_share, u) {
+                MisPick::Bsdf(u) => CandidateDraw::Bsdf(u),
+                MisPick::Light(u) => at.lights.begin_sample(&at.receiver, u).into(),
+            },
         }
     }
 
@@ -288,6 +283,29 @@ impl Strategy {
     pub fn mis_parts(self, at: &GatherPoint, toward: &mut Toward) -> Option<MisParts> {
         let continuous = toward.specular.is_none() && !toward.is_delta();
         (self.effective(at) == Strategy::Mis && continuous).then(|| MisParts::toward(at, toward))
+    }
+}
+
+/// Which of MIS's two samplers a candidate's numbers go to, with the numbers rescaled for
+/// it: the BSDF's below its share, light sampling's above.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum MisPick {
+    /// BSDF sampling, with these numbers.
+    Bsdf([f32; 2]),
+    /// Light sampling, with these numbers.
+    Light([f32; 2]),
+}
+
+impl MisPick {
+    /// Where numbers `u` ∈ [0, 1)² go when the BSDF's share is `share`.
+    #[inline]
+    pub fn of(share: f64, u: [f32; 2]) -> Self {
+        let w = share as f32;
+        if u[0] < w {
+            MisPick::Bsdf([u[0] / w, u[1]])
+        } else {
+            MisPick::Light([((u[0] - w) / (1.0 - w)).min(1.0 - 1e-7), u[1]])
+        }
     }
 }
 
