@@ -414,6 +414,13 @@ impl EnvironmentGuide {
         }
     }
 
+    /// The mixture's weight toward `direction` where its texels do not hold a map's cells
+    /// (a constant environment's uniform texels): its density there is the environment's
+    /// times this ([`EnvironmentGuide::pdf`], to the bit).
+    pub fn weight_toward(&self, direction: Vec3) -> f64 {
+        self.mixture_weight(self.partition.layout.index(direction))
+    }
+
     /// The mixture's density at a direction (solid angle).
     pub fn pdf(&self, environment: &Environment, toward: &mut Toward) -> f64 {
         let (density, texel) = self.partition.density_and_texel(environment, toward);
