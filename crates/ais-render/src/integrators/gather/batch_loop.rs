@@ -217,8 +217,8 @@ fn trace_run(
 /// traced and added up in runs of [`AHEAD`] as [`run_ahead`] does, but with no call into
 /// the driver per candidate. The same estimate and counts, to the bit. Each candidate's
 /// value goes to `spread` where given.
-/// A batch lit by an environment map alone, on a diffuse surface, takes the shortcut of
-/// [`EnvironmentOnly`]: the same estimate.
+/// A batch lit by the environment alone takes the shortcut of [`EnvironmentOnly`]: the
+/// same estimate, without the general candidate's bookkeeping.
 fn run_plain(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,

@@ -167,10 +167,10 @@ impl<'a> EnvironmentOnly<'a> {
             // All the lookups after all the rays, so that they overlap. A blocked candidate
             // adds its zero, as in the general runs (the gather's spread counts it).
             for k in (0..count).filter(|&k| lanes.kept[k]) {
-                let free = lanes.free[k];
-                total.add(match free {
-                    true => self.brought(run, &lanes, k),
-                    false => Vec3::ZERO,
+                total.add(if lanes.free[k] {
+                    self.brought(run, &lanes, k)
+                } else {
+                    Vec3::ZERO
                 });
             }
         }
