@@ -97,6 +97,16 @@ pub enum Aim {
     Unbounded,
 }
 
+/// The shaft toward an area light ([`Lights::shaft_toward`]) and the light's own shape,
+/// which the shaft's rays end before.
+#[derive(Clone, Copy, Debug)]
+pub struct LightShaft {
+    /// The planes around the rays.
+    pub shaft: Shaft,
+    /// The scene's index of the light's shape.
+    pub own_shape: u32,
+}
+
 /// What a shaft toward an area light is built around ([`Lights::shaft_toward`]).
 enum ShaftOutline {
     /// A rectangle's corners, in order around it (a flat mesh's: a rectangle around it).
@@ -530,13 +540,16 @@ impl Lights {
         light: usize,
         apex: Vec3,
         surface: LeavingSurface,
-    ) -> Option<(Shaft, u32)> {
+    ) -> Option<LightShaft> {
         let light = &self.area[light];
         let shaft = match shaft_outline(light)? {
             ShaftOutline::Rectangle(corners) => Shaft::to_rectangle(apex, corners, surface),
             ShaftOutline::Sphere(sphere) => Shaft::to_sphere(apex, sphere, surface),
         }?;
-        Some((shaft, light.shape_index))
+        Some(LightShaft {
+            shaft,
+            own_shape: light.shape_index,
+        })
     }
 
     /// Radiance emitted toward `-direction` by shape `shape` at a point with geometric

@@ -113,5 +113,9 @@ fn shaft_is_clear(world: &World, at: &GatherPoint, light: usize, apex: Vec3) -> 
         offset: height.abs(),
     };
     let shaft = world.lights.shaft_toward(light, apex, surface);
-    shaft.is_some_and(|(shaft, own_shape)| world.geometry.shaft_is_clear(&shaft, own_shape))
+    shaft.is_some_and(|toward| {
+        world
+            .geometry
+            .shaft_is_clear(&toward.shaft, toward.own_shape)
+    })
 }
