@@ -179,6 +179,7 @@ impl Lights {
     }
 
     /// Probability of choosing the environment for `receiver`.
+    #[inline]
     pub(crate) fn environment_choice(&self, receiver: &Receiver) -> f64 {
         self.choice_probability(receiver, self.environment_index())
     }
@@ -426,7 +427,7 @@ impl Lights {
             Some(guide) => guide.pdf(environment, toward),
             None => environment.pdf_toward(toward),
         };
-        self.choice_probability(receiver, self.environment_index()) * density
+        self.environment_choice(receiver) * density
     }
 
     /// What `toward` brings to `receiver` if nothing that does not emit is in the way, and
