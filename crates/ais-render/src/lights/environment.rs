@@ -350,13 +350,6 @@ impl EnvironmentMap {
         let length = (world[0] * world[0] + world[1] * world[1] + world[2] * world[2]).sqrt();
         Vec3::from(world) / length
     }
-
-    /// The sampling density at `direction` (solid angle) and the cell it falls in.
-    #[inline]
-    pub(crate) fn pdf_and_cell(&self, toward: &mut Toward) -> (f32, usize) {
-        let cell = toward.location(self).cell;
-        (self.cell_density[cell], cell)
-    }
 }
 
 /// Each cell's sampling weight: the mean luminance of its four corner texels times its

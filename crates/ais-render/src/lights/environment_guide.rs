@@ -237,20 +237,6 @@ impl EnvironmentPartition {
         let (i, fx) = invert_guided(&within[first..first + count + 1], guide, v as f64);
         Some((cells[start[t] as usize + i] as usize, fx))
     }
-
-    /// The environment's own density at `toward` and the texel it lies in.
-    fn density_and_texel(&self, environment: &Environment, toward: &mut Toward) -> (f64, usize) {
-        match (&self.contents, environment) {
-            (TexelContents::Cells { cell_texel, .. }, Environment::Map(map)) => {
-                let (density, cell) = map.pdf_and_cell(toward);
-                (density as f64, cell_texel[cell] as usize)
-            }
-            _ => (
-                environment.pdf_toward(toward),
-                self.layout.index(toward.direction),
-            ),
-        }
-    }
 }
 
 /// The partitions built for an environment, one per layout, shared by all threads. Cloning
@@ -421,10 +407,17 @@ impl EnvironmentGuide {
         self.mixture_weight(self.partition.layout.index(direction))
     }
 
-    /// The mixture's density at a direction (solid angle).
+    /// The mixture's density at a direction (solid angle): the environment's own density
+    /// there times the weight of the texel it lies in ([`MapWeights::at`] where the texels
+    /// hold a map's cells, [`EnvironmentGuide::weight_toward`] otherwise).
     pub fn pdf(&self, environment: &Environment, toward: &mut Toward) -> f64 {
-        let (density, texel) = self.partition.density_and_texel(environment, toward);
-        density * self.mixture_weight(texel)
+        match (self.map_weights(), environment) {
+            (Some(weights), Environment::Map(map)) => {
+                let location = toward.location(map);
+                map.density_at(location) as f64 * weights.at(location)
+            }
+            _ => environment.pdf_toward(toward) * self.weight_toward(toward.direction),
+        }
     }
 }
 
