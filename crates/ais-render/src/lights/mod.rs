@@ -27,9 +27,10 @@ pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
 pub use rectangle_draws::{AreaChoice, RectangleDraw, RectangleDraws};
 pub use regions::{region_of, RegionChoice, REGIONS, REGION_SIDE};
+pub(crate) use spherical_rectangle::LANES;
 pub use spherical_rectangle::{Rectangle, LEAST_F32_SOLID_ANGLE};
 pub use toward::Toward;
-use toward::{AreaPoint, Source};
+pub(crate) use toward::{AreaPoint, Source};
 
 use crate::geometry::{LeavingSurface, Ray, Shaft, Sphere};
 use ais::sampling::AliasTable;
@@ -525,7 +526,14 @@ impl Lights {
     /// flat mesh (the lights whose shafts [`Lights::shaft_toward`] bounds).
     #[inline]
     pub fn aimed_shaft_light(&self, toward: &Toward) -> Option<usize> {
-        let Source::Area(point) = toward.source else {
+        self.shaft_light_of(&toward.source)
+    }
+
+    /// The area light whose point `source` is, where a shaft bounds its rays
+    /// ([`Lights::aimed_shaft_light`]).
+    #[inline]
+    pub(crate) fn shaft_light_of(&self, source: &Source) -> Option<usize> {
+        let Source::Area(point) = source else {
             return None;
         };
         self.bounded_by_shafts[point.light].then_some(point.light)

@@ -16,17 +16,21 @@ type Nearest = Option<(AreaHit, usize)>;
 impl Lights {
     /// Finds what `toward` meets first among the emitters, if not known yet.
     pub(super) fn resolve(&self, receiver: &Receiver, toward: &mut Toward) {
-        if !matches!(toward.source, Source::Unknown) {
-            return;
+        if matches!(toward.source, Source::Unknown) {
+            toward.source = self.source_along(receiver, toward.direction);
         }
-        let ray = Ray::new(receiver.point, toward.direction);
+    }
+
+    /// What `direction` from `receiver` meets first among the emitters.
+    pub(crate) fn source_along(&self, receiver: &Receiver, direction: Vec3) -> Source {
+        let ray = Ray::new(receiver.point, direction);
         let nearest = self
             .area
             .iter()
             .enumerate()
             .filter_map(|(index, light)| light.intersect(&ray).map(|hit| (hit, index)))
             .min_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
-        toward.source = self.source_at(receiver, toward.direction, nearest);
+        self.source_at(receiver, direction, nearest)
     }
 
     /// Finds what each candidate of `drawn` (empty slots passed over) meets first among the
@@ -49,14 +53,47 @@ impl Lights {
                     (directions[k], unknown[k]) = (toward.direction, true);
                 }
             }
-            if !unknown.contains(&true) {
-                continue;
-            }
-            let nearest = self.nearest_rectangles(receiver.point, &directions);
-            for ((toward, nearest), _) in run.iter_mut().zip(nearest).zip(unknown).filter(|u| u.1) {
-                let toward = toward.as_mut().expect("an unknown direction is drawn");
-                toward.source = self.source_at(receiver, toward.direction, nearest);
-            }
+            self.rectangles_along(receiver, &directions, &unknown, |k, source| {
+                run[k]
+                    .as_mut()
+                    .expect("an unknown direction is drawn")
+                    .source = source;
+            });
+        }
+    }
+
+    /// What each of `directions` from `receiver` whose lane is set in `wanted` meets first
+    /// among the emitters, given to `put` with its lane: the sources [`Lights::source_along`]
+    /// finds one by one, rectangles tested against all the lanes at once.
+    pub(crate) fn sources_along(
+        &self,
+        receiver: &Receiver,
+        directions: &[Vec3; LANES],
+        wanted: &[bool; LANES],
+        mut put: impl FnMut(usize, Source),
+    ) {
+        if self.only_rectangles {
+            return self.rectangles_along(receiver, directions, wanted, put);
+        }
+        for k in (0..LANES).filter(|&k| wanted[k]) {
+            put(k, self.source_along(receiver, directions[k]));
+        }
+    }
+
+    /// [`Lights::sources_along`] where the area lights are all rectangles.
+    fn rectangles_along(
+        &self,
+        receiver: &Receiver,
+        directions: &[Vec3; LANES],
+        wanted: &[bool; LANES],
+        mut put: impl FnMut(usize, Source),
+    ) {
+        if !wanted.contains(&true) {
+            return;
+        }
+        let nearest = self.nearest_rectangles(receiver.point, directions);
+        for k in (0..LANES).filter(|&k| wanted[k]) {
+            put(k, self.source_at(receiver, directions[k], nearest[k]));
         }
     }
 

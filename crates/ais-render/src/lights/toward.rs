@@ -14,7 +14,7 @@ use glam::Vec3;
 
 /// What a candidate direction meets first among the emitters.
 #[derive(Clone, Copy, Debug)]
-pub(super) enum Source {
+pub(crate) enum Source {
     /// Not known yet: found by [`super::Lights`] when first needed.
     Unknown,
     /// The environment: nothing that emits lies along the direction before it.
@@ -29,7 +29,7 @@ pub(super) enum Source {
 
 /// The point of an area light that a candidate direction meets.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct AreaPoint {
+pub(crate) struct AreaPoint {
     /// The light (its index among the scene's area lights).
     pub light: usize,
     /// Where it is (world space).
@@ -126,6 +126,12 @@ impl Toward {
     #[inline]
     pub fn is_point_mass(&self) -> bool {
         self.is_delta() || self.specular.is_some()
+    }
+
+    /// What it meets first among the emitters, as far as known.
+    #[inline]
+    pub(crate) fn source(&self) -> Source {
+        self.source
     }
 
     /// Its place on the environment map, if located.

@@ -2,11 +2,11 @@
 //! driver, traced and recorded. The host loop of the `ais` library, written for this
 //! renderer.
 
-use super::environment_only::EnvironmentOnly;
 use super::gather_sizes::CandidateSpread;
 use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
 use super::mis_share::ShareMoments;
+use super::plain_lanes::PlainLanes;
 use super::settings::GatherSettings;
 use super::shared_origin::SharedOrigin;
 use super::strategy::{CandidateDraw, GatherPoint, MisParts};
@@ -217,8 +217,8 @@ fn trace_run(
 /// traced and added up in runs of [`AHEAD`] as [`run_ahead`] does, but with no call into
 /// the driver per candidate. The same estimate and counts, to the bit. Each candidate's
 /// value goes to `spread` where given.
-/// A batch lit by the environment alone takes the shortcut of [`EnvironmentOnly`]: the
-/// same estimate, without the general candidate's bookkeeping.
+/// A batch that MIS draws, lit by area lights and an environment, runs lane by lane
+/// ([`PlainLanes`]): the same estimate, without the general candidate's bookkeeping.
 fn run_plain(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
@@ -230,8 +230,8 @@ fn run_plain(
         ..PlainSum::default()
     };
     let numbers = batch.begin_plain(run.rays, run.seed);
-    match EnvironmentOnly::of(run) {
-        Some(shortcut) => shortcut.run(run, numbers, counts, &mut total),
+    match PlainLanes::of(run) {
+        Some(lanes) => lanes.run(run, numbers, counts, &mut total),
         None => add_up_plain(run, numbers, counts, &mut total),
     }
     batch.finish_plain(total.sum, total.tally)

@@ -52,7 +52,7 @@ impl Leaving {
 }
 
 /// The shadow ray leaving `at` along `direction`, free up to `target` if given.
-fn shadow_ray(at: &GatherPoint, direction: Vec3, target: Option<Vec3>) -> Ray {
+pub(super) fn shadow_ray(at: &GatherPoint, direction: Vec3, target: Option<Vec3>) -> Ray {
     let (point, normal) = (at.receiver.point, at.frame.geometric);
     // Aimed at the light's point from the offset origin, so that the ray ends just short of
     // it whatever the offset (a ray along the direction from the offset origin can meet a

@@ -15,7 +15,6 @@
 
 pub mod acceptance;
 pub mod batch_loop;
-mod environment_only;
 pub mod field;
 pub mod field_guide;
 pub mod gather_sizes;
@@ -23,6 +22,7 @@ pub mod guiding;
 pub mod learning_pass;
 mod light;
 pub mod mis_share;
+mod plain_lanes;
 pub mod race;
 pub mod settings;
 mod shared_origin;

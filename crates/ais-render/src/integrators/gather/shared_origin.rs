@@ -56,12 +56,17 @@ impl SharedOrigin {
     /// Counts the rays toward each light in a run of candidates about to be traced
     /// (`drawn`, their sources found); without it, no shaft is asked about.
     pub fn expect_run(&mut self, world: &World, drawn: &[Option<Toward>]) {
+        let lights = drawn.iter().flatten();
+        self.expect(lights.map(|toward| world.lights.aimed_shaft_light(toward)));
+    }
+
+    /// [`SharedOrigin::expect_run`] for a run whose rays aim at `lights` (each ray's light
+    /// whose shafts bound its rays, [`crate::lights::Lights::aimed_shaft_light`]).
+    pub fn expect(&mut self, lights: impl IntoIterator<Item = Option<usize>>) {
         self.to_come = [0; TRACKED_LIGHTS];
-        for toward in drawn.iter().flatten() {
-            if let Some(light) = world.lights.aimed_shaft_light(toward) {
-                if light < TRACKED_LIGHTS {
-                    self.to_come[light] = self.to_come[light].saturating_add(1);
-                }
+        for light in lights.into_iter().flatten() {
+            if light < TRACKED_LIGHTS {
+                self.to_come[light] = self.to_come[light].saturating_add(1);
             }
         }
     }
@@ -74,8 +79,20 @@ impl SharedOrigin {
         toward: &Toward,
         ray: &Ray,
     ) -> bool {
-        let light = (world.lights.aimed_shaft_light(toward)).filter(|&l| l < TRACKED_LIGHTS);
-        let Some(light) = light else {
+        let light = world.lights.aimed_shaft_light(toward);
+        self.occluded_aiming(world, at, light, ray)
+    }
+
+    /// Whether `ray` from `at`, a shadow ray toward `light` (as in
+    /// [`SharedOrigin::expect`]), is blocked.
+    pub fn occluded_aiming(
+        &mut self,
+        world: &World,
+        at: &GatherPoint,
+        light: Option<usize>,
+        ray: &Ray,
+    ) -> bool {
+        let Some(light) = light.filter(|&l| l < TRACKED_LIGHTS) else {
             return world.geometry.occluded_after(ray, &mut self.blockers);
         };
         let to_come = self.to_come[light];

@@ -1,0 +1,555 @@
+//! A plain batch (AIS off's, or a guided one of `auto`'s) drawn by MIS in a scene lit by
+//! area lights and an environment (a map or a constant sky, drawn from its own density or
+//! its product with a guide), run lane by lane: a run's directions, places on the map and
+//! sources in arrays of their own, without the general runs' per-candidate record (a
+//! [`Toward`], over a hundred bytes copied between stages) and their dispatch over kinds of
+//! draws and lights. The estimate of the general runs ([`super::batch_loop`]) to the bit.
+//!
+//! [`Toward`]: crate::lights::Toward
+
+use super::batch_loop::{BatchRun, PlainSum};
+use super::light::shadow_ray;
+use super::shared_origin::SharedOrigin;
+use super::strategy::{MisParts, MisPick, Strategy};
+use crate::bsdf::{diffuse_direction, ShadingFrame, SpecularMass};
+use crate::lights::{
+    Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap, MapLocation, MapWeights,
+    Receiver, RectangleDraws, Source, Toward, LANES,
+};
+use crate::render::RayCounts;
+use glam::Vec3;
+use std::f64::consts::PI;
+
+/// How many candidates are drawn, traced and added up together (as many as the lights
+/// find sources for at once, [`crate::lights::Lights::sources_along`]).
+const RUN: usize = LANES;
+
+/// What a lane-by-lane batch needs of its scene and gather point.
+pub(super) struct PlainLanes<'a> {
+    /// The environment, if any.
+    sky: Option<Sky<'a>>,
+    /// MIS's BSDF share.
+    share: f64,
+    /// The probability that light sampling chooses the environment.
+    choice: f64,
+    /// Whether there are area lights: without them, a BSDF-drawn direction meets the
+    /// environment, and no shaft bounds any ray.
+    area: bool,
+    /// A single diffuse material's frame, whose draws are made here (other BSDFs are asked
+    /// for theirs).
+    diffuse: Option<ShadingFrame>,
+}
+
+/// The environment, as the lanes look it up.
+enum Sky<'a> {
+    /// A map, drawn from its own density (no guide) or from a guide whose texels hold its
+    /// cells (the guide's weights over the map's own density).
+    Map {
+        map: &'a EnvironmentMap,
+        guide: Option<MapWeights<'a>>,
+    },
+    /// The same radiance from everywhere, drawn uniformly or from a guide's texels.
+    Constant {
+        radiance: Vec3,
+        guide: Option<&'a EnvironmentGuide>,
+    },
+}
+
+/// What the environment sends along a direction, and light sampling's density of it (the
+/// choice of the environment left out).
+struct SkyLight {
+    radiance: Vec3,
+    density: f64,
+}
+
+impl<'a> Sky<'a> {
+    /// `environment`, as drawn for `receiver` (`None`: by a guide whose texels split a map's
+    /// cells, which has no weight per cell).
+    fn of(environment: &'a Environment, receiver: &Receiver<'a>) -> Option<Self> {
+        let guide = receiver.environment_guide;
+        Some(match environment {
+            Environment::Map(map) => Sky::Map {
+                map,
+                guide: match guide {
+                    Some(guide) => Some(guide.map_weights()?),
+                    None => None,
+                },
+            },
+            &Environment::Constant(radiance) => Sky::Constant { radiance, guide },
+        })
+    }
+
+    /// What arrives along `direction` (at `location` on a map if drawn from it). The
+    /// densities are the general lookups' to the bit: an unguided one is multiplied by 1.
+    /// (Always inlined: called from both forms of the lanes, it was not, and scenes lit by
+    /// a sky lost 3%.)
+    #[inline(always)]
+    fn toward(&self, direction: Vec3, location: Option<MapLocation>) -> SkyLight {
+        match self {
+            Sky::Map { map, guide } => {
+                let location = location.unwrap_or_else(|| map.locate(direction));
+                let guided = guide.map_or(1.0, |weights| weights.at(location));
+                SkyLight {
+                    radiance: map.radiance_at(location),
+                    density: map.density_at(location) as f64 * guided,
+                }
+            }
+            Sky::Constant { radiance, guide } => {
+                let guided = guide.map_or(1.0, |guide| guide.weight_toward(direction));
+                SkyLight {
+                    radiance: *radiance,
+                    density: 1.0 / (4.0 * PI) * guided,
+                }
+            }
+        }
+    }
+}
+
+/// The candidates of one run, lane by lane.
+struct Lanes {
+    /// Each candidate's direction.
+    direction: [Vec3; RUN],
+    /// Where a candidate drawn from the map falls on it (`None`: drawn otherwise, to be
+    /// located if it meets the environment and its ray is free).
+    location: [Option<MapLocation>; RUN],
+    /// What it meets first among the emitters ([`Source::Unknown`] until found).
+    source: [Source; RUN],
+    /// Whether a direction was drawn and lies inside the BSDF's support.
+    kept: [bool; RUN],
+    /// Whether its shadow ray was traced and is free.
+    free: [bool; RUN],
+    /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
+    specular: [Option<SpecularMass>; RUN],
+}
+
+impl Default for Lanes {
+    fn default() -> Self {
+        Lanes {
+            // Unit directions in lanes never drawn: the lights' tests over all the lanes
+            // stay finite there.
+            direction: [Vec3::Z; RUN],
+            location: [None; RUN],
+            source: [Source::Unknown; RUN],
+            kept: [false; RUN],
+            free: [false; RUN],
+            specular: [None; RUN],
+        }
+    }
+}
+
+impl<'a> PlainLanes<'a> {
+    /// The batch's lanes, where they apply: an unguided MIS proposal, and lights that are
+    /// area lights and an environment (a constant one, or a map drawn from its own density
+    /// or from a guide whose texels hold its cells), no delta light. Any BSDF: its own
+    /// draws and densities are asked of it.
+    pub(super) fn of(run: &BatchRun<'a>) -> Option<Self> {
+        let at = run.at;
+        let lights = at.lights;
+        let unguided_mis = run.sampler.unguided() == Some(Strategy::Mis);
+        if !unguided_mis || lights.is_empty() || !lights.delta.is_empty() {
+            return None;
+        }
+        // (Without an environment, its probability is not asked for: there is none.)
+        let (sky, choice) = match &lights.environment {
+            Some(environment) => (
+                Some(Sky::of(environment, &at.receiver)?),
+                lights.environment_choice(&at.receiver),
+            ),
+            None => (None, 0.0),
+        };
+        Some(PlainLanes {
+            sky,
+            diffuse: at.bsdf.diffuse_frame().copied(),
+            share: at.mis_bsdf_share,
+            choice,
+            area: !lights.area.is_empty(),
+        })
+    }
+
+    /// Draws, traces and adds up the candidates of `numbers` (the batch's, from
+    /// [`ais::Batch::begin_plain`]) into `total`.
+    pub(super) fn run(
+        &self,
+        run: &BatchRun,
+        numbers: &[[f32; 2]],
+        counts: &mut RayCounts,
+        total: &mut PlainSum,
+    ) {
+        // Compiled twice: lit by the environment alone, the lanes keep no sources (each
+        // step's work on them measured 2% of a frame in scenes lit by a sky).
+        match self.area {
+            true => self.run_lanes::<true>(run, numbers, counts, total),
+            false => self.run_lanes::<false>(run, numbers, counts, total),
+        }
+    }
+
+    /// [`PlainLanes::run`], with area lights among the lights (`AREA`) or none.
+    fn run_lanes<const AREA: bool>(
+        &self,
+        run: &BatchRun,
+        numbers: &[[f32; 2]],
+        counts: &mut RayCounts,
+        total: &mut PlainSum,
+    ) {
+        let mut origin = SharedOrigin::default();
+        let mut lanes = Lanes::default();
+        for numbers in numbers.chunks(RUN) {
+            let count = numbers.len();
+            self.draw::<AREA>(run, numbers, &mut lanes);
+            let kept = lanes.kept[..count].iter().filter(|&&kept| kept).count();
+            total.count_run(count, kept);
+            if AREA {
+                meet(run, &mut lanes, count);
+            }
+            trace::<AREA>(run, &mut lanes, count, counts, &mut origin);
+            // All the lookups after all the rays, so that they overlap. A candidate whose
+            // ray was blocked or not needed adds its zero, as in the general runs (the
+            // gather's spread counts it).
+            for k in (0..count).filter(|&k| lanes.kept[k]) {
+                total.add(if lanes.free[k] {
+                    self.brought::<AREA>(run, &lanes, k)
+                } else {
+                    Vec3::ZERO
+                });
+            }
+        }
+    }
+
+    /// Draws the candidates of `numbers` into `lanes`: the map's all together
+    /// ([`EnvironmentDraws`]), then the rectangle lights' ([`RectangleDraws`]), then the
+    /// BSDF's ([`GatherPoint::draw_bsdf_run`]), and which carry light to the viewer
+    /// ([`GatherPoint::carries`]).
+    ///
+    /// [`GatherPoint::draw_bsdf_run`]: super::strategy::GatherPoint::draw_bsdf_run
+    /// [`GatherPoint::carries`]: super::strategy::GatherPoint::carries
+    fn draw<const AREA: bool>(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
+        let at = run.at;
+        let mut environment = EnvironmentDraws::default();
+        let mut rectangles = RectangleDraws::default();
+        let mut bsdf_numbers = [[0.0; 2]; RUN];
+        let mut bsdf_slots = [0; RUN];
+        let mut bsdf_draws = 0;
+        let mut drawn = [false; RUN];
+        // What a BSDF-drawn direction meets: looked for later where area lights could be
+        // in the way.
+        // (Lit by the environment alone, the lanes keep no sources: all meet it.)
+        let bsdf_source = Source::Unknown;
+        let mut made = |k: usize, toward: &Toward, source: Source, drawn: &mut [bool; RUN]| {
+            lanes.direction[k] = toward.direction;
+            lanes.location[k] = toward.map_location();
+            if AREA {
+                lanes.source[k] = source;
+            }
+            lanes.specular[k] = toward.specular;
+            drawn[k] = true;
+        };
+        for (k, &u) in numbers.iter().enumerate() {
+            let u = match MisPick::of(self.share, u) {
+                MisPick::Bsdf(u) => {
+                    match &self.diffuse {
+                        Some(frame) => {
+                            let toward = Toward::new(diffuse_direction(frame, u));
+                            made(k, &toward, bsdf_source, &mut drawn);
+                        }
+                        None => {
+                            (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
+                            bsdf_draws += 1;
+                        }
+                    }
+                    continue;
+                }
+                MisPick::Light(u) => u,
+            };
+            match at.lights.begin_sample(&at.receiver, u) {
+                Draw::Environment(u) => environment.push(k, u),
+                Draw::Rectangle(draw) => rectangles.push(k, draw),
+                Draw::Made(toward) => {
+                    if let Some(toward) = toward {
+                        made(k, &toward, toward.source(), &mut drawn);
+                    }
+                }
+            }
+        }
+        let receiver = &at.receiver;
+        environment.draw(at.lights, receiver, |k, toward| {
+            made(k, &toward, Source::Environment, &mut drawn);
+        });
+        rectangles.draw(at.lights, receiver, |k, toward| {
+            made(k, &toward, toward.source(), &mut drawn);
+        });
+        at.draw_bsdf_run(&bsdf_numbers[..bsdf_draws], |i, toward| {
+            if let Some(toward) = toward {
+                made(bsdf_slots[i], &toward, bsdf_source, &mut drawn);
+            }
+        });
+        for (k, &drawn) in drawn[..numbers.len()].iter().enumerate() {
+            lanes.kept[k] = drawn
+                && (lanes.specular[k].is_some() || at.bsdf.in_support(at.wo, lanes.direction[k]));
+        }
+    }
+
+    /// What candidate `k` of `lanes`, whose ray is free, brings (f·L/p, as the general runs
+    /// weigh it: along a specular lobe, its mass over the probability of picking it).
+    #[inline]
+    fn brought<const AREA: bool>(&self, run: &BatchRun, lanes: &Lanes, k: usize) -> Vec3 {
+        let at = run.at;
+        let direction = lanes.direction[k];
+        let source = match AREA {
+            true => &lanes.source[k],
+            false => &Source::Environment,
+        };
+        let (radiance, light_density) = match (source, &self.sky) {
+            (Source::Area(point), _) => (point.radiance, point.density),
+            (Source::Environment, Some(sky)) => {
+                let arriving = sky.toward(direction, lanes.location[k]);
+                (arriving.radiance, self.choice * arriving.density)
+            }
+            _ => unreachable!("a free ray meets an area light or the environment"),
+        };
+        let (scattering, pdf) = match lanes.specular[k] {
+            Some(mass) => (mass.weight, self.share * mass.probability as f64),
+            None => {
+                let parts = MisParts {
+                    bsdf: at.bsdf.pdf(at.wo, direction),
+                    light: light_density,
+                };
+                (at.bsdf.eval(at.wo, direction), parts.mixed(self.share))
+            }
+        };
+        if pdf <= 0.0 || radiance == Vec3::ZERO {
+            return Vec3::ZERO;
+        }
+        scattering * radiance / pdf as f32
+    }
+}
+
+/// Finds what the kept candidates of `lanes` (the first `count`) whose sources are not
+/// known meet first among the emitters: the BSDF's draws.
+fn meet(run: &BatchRun, lanes: &mut Lanes, count: usize) {
+    let wanted: [bool; RUN] = std::array::from_fn(|k| {
+        k < count && lanes.kept[k] && matches!(lanes.source[k], Source::Unknown)
+    });
+    let receiver = &run.at.receiver;
+    let source = &mut lanes.source;
+    (run.world.lights).sources_along(receiver, &lanes.direction, &wanted, |k, met| {
+        source[k] = met
+    });
+}
+
+/// Traces the shadow rays of the kept candidates of `lanes` (the first `count`) that could
+/// bring light, toward the point of the area light they meet or the environment, with what
+/// the gather's earlier rays learned (`origin`), and notes which are free. Without area
+/// lights (`AREA`), every one meets the environment and no shaft bounds any.
+fn trace<const AREA: bool>(
+    run: &BatchRun,
+    lanes: &mut Lanes,
+    count: usize,
+    counts: &mut RayCounts,
+    origin: &mut SharedOrigin,
+) {
+    let (world, at) = (run.world, run.at);
+    let lights = &world.lights;
+    let shaft_light = |source: &Source| match AREA {
+        true => lights.shaft_light_of(source),
+        false => None,
+    };
+    if AREA {
+        let aimed = (0..count).filter(|&k| lanes.kept[k]);
+        origin.expect(aimed.map(|k| shaft_light(&lanes.source[k])));
+    }
+    for k in 0..count {
+        let target = match &lanes.source[k] {
+            _ if !lanes.kept[k] => None,
+            _ if !AREA => Some(None),
+            Source::Area(point) if point.radiance != Vec3::ZERO => Some(Some(point.target)),
+            Source::Environment => Some(None),
+            _ => None,
+        };
+        lanes.free[k] = target.is_some_and(|target| {
+            counts.occlusion += 1;
+            let ray = shadow_ray(at, lanes.direction[k], target);
+            !origin.occluded_aiming(world, at, shaft_light(&lanes.source[k]), &ray)
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::batch_loop::add_up_plain;
+    use super::super::gather_sizes::CandidateSpread;
+    use super::super::guiding::CandidateSampler;
+    use super::super::settings::GatherSettings;
+    use super::super::strategy::gather_point;
+    use super::*;
+    use crate::geometry::Ray;
+    use crate::image_io::{write_exr, RgbImage};
+    use crate::lights::{EnvironmentPartition, GuideLayout, RegionChoice, REGIONS};
+    use crate::scene::load_scene;
+    use crate::world::World;
+    use ais::rng::Pcg32;
+    use ais::sampling::AliasTable;
+    use ais::{Batch, BatchConfig, MapStart};
+    use std::sync::Arc;
+
+    /// A diffuse floor with a smooth plastic box and a rough metal ball on it under
+    /// `emitter`, in a scratch folder named after `name` (holding `sky.exr`: a map of 32 × 16
+    /// texels with a small sun).
+    fn scene_under(name: &str, emitter: &str) -> World {
+        let dir = std::env::temp_dir().join(format!("ais-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mut sky = RgbImage::new(32, 16);
+        for (i, pixel) in sky.pixels.iter_mut().enumerate() {
+            let v = 0.1 + (i / 32) as f32 / 16.0 + 0.02 * (i % 32) as f32;
+            *pixel = [v, 0.9 * v, 0.7 * v];
+        }
+        sky.pixels[3 * 32 + 5] = [400.0; 3];
+        write_exr(&dir.join("sky.exr"), &sky).unwrap();
+        let xml = format!(
+            r#"<scene version="3.0.0">{emitter}
+            <bsdf type="diffuse" id="grey"><rgb name="reflectance" value="0.6, 0.5, 0.4"/></bsdf>
+            <shape type="rectangle"><transform name="to_world"><scale value="4"/></transform><ref id="grey"/></shape>
+            <shape type="cube"><transform name="to_world"><scale value="0.5"/><translate z="0.5"/></transform>
+                <bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.2, 0.4, 0.6"/></bsdf></shape>
+            <shape type="sphere"><point name="center" x="-1" y="0.8" z="0.4"/><float name="radius" value="0.4"/>
+                <bsdf type="roughconductor"><float name="alpha" value="0.2"/></bsdf></shape>
+        </scene>"#
+        );
+        std::fs::write(dir.join("scene.xml"), xml).unwrap();
+        World::from_description(load_scene(&dir.join("scene.xml"), &[]).unwrap()).unwrap()
+    }
+
+    /// Two guides of `partition`'s texels: the product alone, and mixed half and half.
+    fn guides(partition: Arc<EnvironmentPartition>) -> [Option<EnvironmentGuide>; 2] {
+        let mut guides = [1.0, 0.5].map(|fraction| {
+            let mut guide = EnvironmentGuide::new(partition.clone());
+            guide.set_affinities(|t| 0.01 + ((t * 5) % 7) as f32);
+            guide.set_fraction(fraction);
+            guide
+        });
+        guides[1].set_affinities(|t| (t % 3) as f32);
+        guides.map(Some)
+    }
+
+    /// Compares the lanes with the general runs at 400 gather points of `world` seen from
+    /// above, lit and in shadow, for several MIS shares and batch sizes, unguided and with
+    /// each of `guides`, the lights chosen by power and by a cell's learned choice (with
+    /// the first area light's regions weighed, where there is one): their estimates,
+    /// counts and spreads must be the same to the bit.
+    fn compare_batches(world: &World, guides: &[Option<EnvironmentGuide>; 2]) {
+        let lights = &world.lights;
+        let choice_weights: Vec<f64> = (0..lights.source_count())
+            .map(|l| 0.2 + (l % 3) as f64)
+            .collect();
+        let light_choice = AliasTable::new(&choice_weights);
+        let region_weights: [f64; REGIONS] = std::array::from_fn(|r| 0.5 + (r % 4) as f64);
+        let mut region_choices = vec![None; lights.area.len()];
+        if let Some(first) = region_choices.first_mut() {
+            *first = RegionChoice::new(&region_weights);
+        }
+        let settings = GatherSettings::default();
+        let sampler = CandidateSampler::plain(Strategy::Mis);
+        let mut batch = Batch::<[f32; 3]>::new(BatchConfig::off()).unwrap();
+        let mut rng = Pcg32::new(5, 0);
+        let mut compared = 0;
+        for trial in 0..400u64 {
+            let target = Vec3::new(rng.next_f32() * 3.0 - 1.5, rng.next_f32() * 3.0 - 1.5, 0.0);
+            let eye = Vec3::new(2.0, -3.0, 2.5);
+            let ray = Ray::new(eye, (target - eye).normalize());
+            let Some(hit) = world.geometry.intersect(&ray) else {
+                continue;
+            };
+            let mut at = gather_point(world, &hit, (eye - hit.point).normalize());
+            at.mis_bsdf_share = [0.5, 0.25, 0.8][trial as usize % 3];
+            at.receiver.environment_guide =
+                [None, guides[0].as_ref(), guides[1].as_ref()][(trial / 3) as usize % 3];
+            if trial % 4 == 1 {
+                at.receiver.light_choice = Some(&light_choice);
+                at.receiver.region_choices = &region_choices;
+            }
+            let run = BatchRun {
+                world,
+                settings: &settings,
+                rays: 7 + (trial % 20) as u32,
+                at: &at,
+                sampler: &sampler,
+                seed: trial,
+                start: MapStart::Empty,
+                field: None,
+                clock: None,
+            };
+            let lanes = PlainLanes::of(&run).expect("lights the lanes take");
+            let numbers = batch.begin_plain(run.rays, run.seed).to_vec();
+            let totals = [true, false].map(|in_lanes| {
+                let mut spread = CandidateSpread::default();
+                let mut counts = RayCounts::default();
+                let mut total = PlainSum {
+                    spread: Some(&mut spread),
+                    ..PlainSum::default()
+                };
+                match in_lanes {
+                    true => lanes.run(&run, &numbers, &mut counts, &mut total),
+                    false => add_up_plain(&run, &numbers, &mut counts, &mut total),
+                }
+                let (sum, tally) = (total.sum, total.tally);
+                format!("{sum:?} {tally:?} {counts:?} {spread:?}")
+            });
+            assert_eq!(totals[0], totals[1], "gather {trial}");
+            compared += 1;
+        }
+        assert!(compared > 300, "{compared} gathers hit the scene");
+    }
+
+    /// A rotated map.
+    const MAP: &str = r#"<emitter type="envmap"><string name="filename" value="sky.exr"/>
+            <transform name="to_world"><rotate x="1" angle="90"/><rotate z="1" angle="30"/></transform></emitter>"#;
+
+    /// A rectangle light facing the floor, a sphere light, and a small cube (a mesh) that
+    /// emits.
+    const AREA_LIGHTS: &str = r#"
+        <shape type="rectangle"><transform name="to_world"><scale value="0.4"/><rotate x="1" angle="180"/>
+            <translate x="0.6" y="0.3" z="2.2"/></transform>
+            <emitter type="area"><rgb name="radiance" value="9, 8, 7"/></emitter></shape>
+        <shape type="sphere"><point name="center" x="1.2" y="-1" z="1.1"/><float name="radius" value="0.2"/>
+            <emitter type="area"><rgb name="radiance" value="20, 12, 6"/></emitter></shape>
+        <shape type="cube"><transform name="to_world"><scale value="0.15"/><translate x="-0.9" y="-0.9" z="1.4"/></transform>
+            <emitter type="area"><rgb name="radiance" value="5, 9, 14"/></emitter></shape>"#;
+
+    /// Under a rotated map, drawn from its own density and from a guide whose texels hold
+    /// its cells.
+    #[test]
+    fn the_lanes_are_the_general_batch_to_the_bit_under_a_map() {
+        let world = scene_under("plain-lanes-map", MAP);
+        let Some(Environment::Map(map)) = &world.lights.environment else {
+            unreachable!("the scene has a map")
+        };
+        compare_batches(&world, &guides(map.partition(GuideLayout::Octahedral(8))));
+    }
+
+    /// Under a constant sky, drawn uniformly and from a guide's uniform texels.
+    #[test]
+    fn the_lanes_are_the_general_batch_to_the_bit_under_a_constant_sky() {
+        let emitter =
+            r#"<emitter type="constant"><rgb name="radiance" value="0.8, 0.9, 1"/></emitter>"#;
+        let world = scene_under("plain-lanes-constant", emitter);
+        compare_batches(&world, &guides(Arc::new(EnvironmentPartition::uniform(8))));
+    }
+
+    /// Under a map and area lights of three kinds, which shadow one another.
+    #[test]
+    fn the_lanes_are_the_general_batch_to_the_bit_under_a_map_and_area_lights() {
+        let world = scene_under("plain-lanes-map-and-area", &format!("{MAP}{AREA_LIGHTS}"));
+        let Some(Environment::Map(map)) = &world.lights.environment else {
+            unreachable!("the scene has a map")
+        };
+        assert_eq!(world.lights.area.len(), 3);
+        compare_batches(&world, &guides(map.partition(GuideLayout::Octahedral(8))));
+    }
+
+    /// Lit by area lights alone: a direction from the BSDF that meets none brings nothing.
+    #[test]
+    fn the_lanes_are_the_general_batch_to_the_bit_under_area_lights_alone() {
+        let world = scene_under("plain-lanes-area", AREA_LIGHTS);
+        assert!(world.lights.environment.is_none());
+        compare_batches(&world, &[None, None]);
+    }
+}
