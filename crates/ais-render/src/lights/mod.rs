@@ -185,6 +185,13 @@ impl Lights {
         self.choice_probability(receiver, self.environment_index())
     }
 
+    /// Probability of choosing delta light `delta` for `receiver`: a point mass of light
+    /// sampling.
+    #[inline]
+    pub(crate) fn delta_choice(&self, receiver: &Receiver, delta: usize) -> f64 {
+        self.choice_probability(receiver, self.area.len() + delta)
+    }
+
     /// Whether the scene has no emitter at all.
     pub fn is_empty(&self) -> bool {
         self.choice.is_none()
@@ -412,7 +419,7 @@ impl Lights {
     pub fn pdf_toward(&self, receiver: &Receiver, toward: &mut Toward) -> f64 {
         self.resolve(receiver, toward);
         match toward.source {
-            Source::Delta(delta, _) => self.choice_probability(receiver, self.area.len() + delta),
+            Source::Delta(delta, _) => self.delta_choice(receiver, delta),
             Source::Area(point) => point.density,
             Source::Environment => self.environment_density(receiver, toward),
             Source::Dark | Source::Unknown => 0.0,
@@ -438,7 +445,7 @@ impl Lights {
     #[inline]
     pub fn unoccluded(&self, receiver: &Receiver, toward: &mut Toward) -> (Vec3, Option<Vec3>) {
         let radiance = self.radiance_toward(receiver, toward);
-        (radiance, self.target(receiver, toward))
+        (radiance, self.target(receiver, &toward.source))
     }
 
     /// The radiance of [`Lights::unoccluded`] alone, without the point it comes from.
@@ -458,8 +465,8 @@ impl Lights {
 
     /// Where the shadow ray of `toward` (resolved) must be free to: a finite point, or
     /// `None` toward the environment and a directional light.
-    fn target(&self, receiver: &Receiver, toward: &Toward) -> Option<Vec3> {
-        match toward.source {
+    fn target(&self, receiver: &Receiver, source: &Source) -> Option<Vec3> {
+        match *source {
             Source::Delta(_, arrival) => arrival
                 .distance
                 .is_finite()
@@ -477,7 +484,13 @@ impl Lights {
     #[inline]
     pub fn aim(&self, receiver: &Receiver, toward: &mut Toward) -> Aim {
         self.resolve(receiver, toward);
-        let brings_nothing = match toward.source {
+        self.aim_at(receiver, &toward.source)
+    }
+
+    /// [`Lights::aim`] for a direction from `receiver` that meets `source` first.
+    #[inline]
+    pub(crate) fn aim_at(&self, receiver: &Receiver, source: &Source) -> Aim {
+        let brings_nothing = match *source {
             Source::Delta(_, arrival) => arrival.light == Vec3::ZERO,
             Source::Area(point) => point.radiance == Vec3::ZERO,
             Source::Environment => false,
@@ -486,7 +499,7 @@ impl Lights {
         if brings_nothing {
             return Aim::Nothing;
         }
-        self.target(receiver, toward)
+        self.target(receiver, source)
             .map_or(Aim::Unbounded, Aim::Point)
     }
 

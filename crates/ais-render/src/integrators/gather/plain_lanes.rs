@@ -1,9 +1,9 @@
-//! A plain batch (AIS off's, or a guided one of `auto`'s) drawn by MIS in a scene lit by
-//! area lights and an environment (a map or a constant sky, drawn from its own density or
-//! its product with a guide), run lane by lane: a run's directions, places on the map and
-//! sources in arrays of their own, without the general runs' per-candidate record (a
-//! [`Toward`], over a hundred bytes copied between stages) and their dispatch over kinds of
-//! draws and lights. The estimate of the general runs ([`super::batch_loop`]) to the bit.
+//! A plain batch (AIS off's, or a guided one of `auto`'s) drawn by MIS, run lane by lane:
+//! a run's directions, places on the map and sources in arrays of their own, without the
+//! general runs' per-candidate record (a [`Toward`], over a hundred bytes copied between
+//! stages) and their dispatch over kinds of draws. Any lights: area and delta lights, and
+//! an environment (a map or a constant sky, drawn from its own density or its product with
+//! a guide). The estimate of the general runs ([`super::batch_loop`]) to the bit.
 //!
 //! [`Toward`]: crate::lights::Toward
 
@@ -13,8 +13,8 @@ use super::shared_origin::SharedOrigin;
 use super::strategy::{MisParts, MisPick, Strategy};
 use crate::bsdf::{diffuse_direction, ShadingFrame, SpecularMass};
 use crate::lights::{
-    Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap, MapLocation, MapWeights,
-    Receiver, RectangleDraws, Source, Toward, LANES,
+    Aim, Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap, MapLocation,
+    MapWeights, Receiver, RectangleDraws, Source, Toward, LANES,
 };
 use crate::render::RayCounts;
 use glam::Vec3;
@@ -32,9 +32,9 @@ pub(super) struct PlainLanes<'a> {
     share: f64,
     /// The probability that light sampling chooses the environment.
     choice: f64,
-    /// Whether there are area lights: without them, a BSDF-drawn direction meets the
-    /// environment, and no shaft bounds any ray.
-    area: bool,
+    /// Whether there are lights besides the environment: without them, every candidate
+    /// meets the environment, and no shaft bounds any ray.
+    sources: bool,
     /// A single diffuse material's frame, whose draws are made here (other BSDFs are asked
     /// for theirs).
     diffuse: Option<ShadingFrame>,
@@ -138,15 +138,15 @@ impl Default for Lanes {
 }
 
 impl<'a> PlainLanes<'a> {
-    /// The batch's lanes, where they apply: an unguided MIS proposal, and lights that are
-    /// area lights and an environment (a constant one, or a map drawn from its own density
-    /// or from a guide whose texels hold its cells), no delta light. Any BSDF: its own
-    /// draws and densities are asked of it.
+    /// The batch's lanes, where they apply: an unguided MIS proposal, and an environment
+    /// that is a constant one, or a map drawn from its own density or from a guide whose
+    /// texels hold its cells (or none), beside any other lights. Any BSDF: its own draws
+    /// and densities are asked of it.
     pub(super) fn of(run: &BatchRun<'a>) -> Option<Self> {
         let at = run.at;
         let lights = at.lights;
         let unguided_mis = run.sampler.unguided() == Some(Strategy::Mis);
-        if !unguided_mis || lights.is_empty() || !lights.delta.is_empty() {
+        if !unguided_mis || lights.is_empty() {
             return None;
         }
         // (Without an environment, its probability is not asked for: there is none.)
@@ -162,7 +162,7 @@ impl<'a> PlainLanes<'a> {
             diffuse: at.bsdf.diffuse_frame().copied(),
             share: at.mis_bsdf_share,
             choice,
-            area: !lights.area.is_empty(),
+            sources: !(lights.area.is_empty() && lights.delta.is_empty()),
         })
     }
 
@@ -177,14 +177,14 @@ impl<'a> PlainLanes<'a> {
     ) {
         // Compiled twice: lit by the environment alone, the lanes keep no sources (each
         // step's work on them measured 2% of a frame in scenes lit by a sky).
-        match self.area {
+        match self.sources {
             true => self.run_lanes::<true>(run, numbers, counts, total),
             false => self.run_lanes::<false>(run, numbers, counts, total),
         }
     }
 
-    /// [`PlainLanes::run`], with area lights among the lights (`AREA`) or none.
-    fn run_lanes<const AREA: bool>(
+    /// [`PlainLanes::run`], with lights besides the environment (`SOURCES`) or none.
+    fn run_lanes<const SOURCES: bool>(
         &self,
         run: &BatchRun,
         numbers: &[[f32; 2]],
@@ -195,19 +195,19 @@ impl<'a> PlainLanes<'a> {
         let mut lanes = Lanes::default();
         for numbers in numbers.chunks(RUN) {
             let count = numbers.len();
-            self.draw::<AREA>(run, numbers, &mut lanes);
+            self.draw::<SOURCES>(run, numbers, &mut lanes);
             let kept = lanes.kept[..count].iter().filter(|&&kept| kept).count();
             total.count_run(count, kept);
-            if AREA {
+            if SOURCES {
                 meet(run, &mut lanes, count);
             }
-            trace::<AREA>(run, &mut lanes, count, counts, &mut origin);
+            trace::<SOURCES>(run, &mut lanes, count, counts, &mut origin);
             // All the lookups after all the rays, so that they overlap. A candidate whose
             // ray was blocked or not needed adds its zero, as in the general runs (the
             // gather's spread counts it).
             for k in (0..count).filter(|&k| lanes.kept[k]) {
                 total.add(if lanes.free[k] {
-                    self.brought::<AREA>(run, &lanes, k)
+                    self.brought::<SOURCES>(run, &lanes, k)
                 } else {
                     Vec3::ZERO
                 });
@@ -222,7 +222,7 @@ impl<'a> PlainLanes<'a> {
     ///
     /// [`GatherPoint::draw_bsdf_run`]: super::strategy::GatherPoint::draw_bsdf_run
     /// [`GatherPoint::carries`]: super::strategy::GatherPoint::carries
-    fn draw<const AREA: bool>(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
+    fn draw<const SOURCES: bool>(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
         let at = run.at;
         let mut environment = EnvironmentDraws::default();
         let mut rectangles = RectangleDraws::default();
@@ -237,7 +237,7 @@ impl<'a> PlainLanes<'a> {
         let mut made = |k: usize, toward: &Toward, source: Source, drawn: &mut [bool; RUN]| {
             lanes.direction[k] = toward.direction;
             lanes.location[k] = toward.map_location();
-            if AREA {
+            if SOURCES {
                 lanes.source[k] = source;
             }
             lanes.specular[k] = toward.specular;
@@ -291,10 +291,10 @@ impl<'a> PlainLanes<'a> {
     /// What candidate `k` of `lanes`, whose ray is free, brings (f·L/p, as the general runs
     /// weigh it: along a specular lobe, its mass over the probability of picking it).
     #[inline]
-    fn brought<const AREA: bool>(&self, run: &BatchRun, lanes: &Lanes, k: usize) -> Vec3 {
+    fn brought<const SOURCES: bool>(&self, run: &BatchRun, lanes: &Lanes, k: usize) -> Vec3 {
         let at = run.at;
         let direction = lanes.direction[k];
-        let source = match AREA {
+        let source = match SOURCES {
             true => &lanes.source[k],
             false => &Source::Environment,
         };
@@ -304,7 +304,12 @@ impl<'a> PlainLanes<'a> {
                 let arriving = sky.toward(direction, lanes.location[k]);
                 (arriving.radiance, self.choice * arriving.density)
             }
-            _ => unreachable!("a free ray meets an area light or the environment"),
+            (&Source::Delta(delta, arrival), _) => {
+                // A point mass of light sampling, which the BSDF's density does not add to.
+                let pdf = (1.0 - self.share) * at.lights.delta_choice(&at.receiver, delta);
+                return weighed(at.bsdf.eval(at.wo, direction), arrival.light, pdf);
+            }
+            _ => unreachable!("a free ray meets a light or the environment"),
         };
         let (scattering, pdf) = match lanes.specular[k] {
             Some(mass) => (mass.weight, self.share * mass.probability as f64),
@@ -316,11 +321,19 @@ impl<'a> PlainLanes<'a> {
                 (at.bsdf.eval(at.wo, direction), parts.mixed(self.share))
             }
         };
-        if pdf <= 0.0 || radiance == Vec3::ZERO {
-            return Vec3::ZERO;
-        }
-        scattering * radiance / pdf as f32
+        weighed(scattering, radiance, pdf)
     }
+}
+
+/// f·L/p of a candidate whose surface scatters by `scattering` the `radiance` arriving,
+/// drawn with probability (density) `pdf`: nothing at a zero density (possible only at a
+/// light's rim in f32) or a zero radiance.
+#[inline]
+fn weighed(scattering: Vec3, radiance: Vec3, pdf: f64) -> Vec3 {
+    if pdf <= 0.0 || radiance == Vec3::ZERO {
+        return Vec3::ZERO;
+    }
+    scattering * radiance / pdf as f32
 }
 
 /// Finds what the kept candidates of `lanes` (the first `count`) whose sources are not
@@ -339,8 +352,8 @@ fn meet(run: &BatchRun, lanes: &mut Lanes, count: usize) {
 /// Traces the shadow rays of the kept candidates of `lanes` (the first `count`) that could
 /// bring light, toward the point of the area light they meet or the environment, with what
 /// the gather's earlier rays learned (`origin`), and notes which are free. Without area
-/// lights (`AREA`), every one meets the environment and no shaft bounds any.
-fn trace<const AREA: bool>(
+/// lights besides the environment (`SOURCES`), every one meets it and no shaft bounds any.
+fn trace<const SOURCES: bool>(
     run: &BatchRun,
     lanes: &mut Lanes,
     count: usize,
@@ -349,21 +362,24 @@ fn trace<const AREA: bool>(
 ) {
     let (world, at) = (run.world, run.at);
     let lights = &world.lights;
-    let shaft_light = |source: &Source| match AREA {
+    let shaft_light = |source: &Source| match SOURCES {
         true => lights.shaft_light_of(source),
         false => None,
     };
-    if AREA {
+    if SOURCES {
         let aimed = (0..count).filter(|&k| lanes.kept[k]);
         origin.expect(aimed.map(|k| shaft_light(&lanes.source[k])));
     }
     for k in 0..count {
-        let target = match &lanes.source[k] {
-            _ if !lanes.kept[k] => None,
-            _ if !AREA => Some(None),
-            Source::Area(point) if point.radiance != Vec3::ZERO => Some(Some(point.target)),
-            Source::Environment => Some(None),
-            _ => None,
+        let aim = match SOURCES {
+            _ if !lanes.kept[k] => Aim::Nothing,
+            true => lights.aim_at(&at.receiver, &lanes.source[k]),
+            false => Aim::Unbounded,
+        };
+        let target = match aim {
+            Aim::Nothing => None,
+            Aim::Point(target) => Some(Some(target)),
+            Aim::Unbounded => Some(None),
         };
         lanes.free[k] = target.is_some_and(|target| {
             counts.occlusion += 1;
@@ -543,6 +559,20 @@ mod tests {
         };
         assert_eq!(world.lights.area.len(), 3);
         compare_batches(&world, &guides(map.partition(GuideLayout::Octahedral(8))));
+    }
+
+    /// Under a constant sky, area lights and delta lights (a point light, a spot light and a
+    /// directional light).
+    #[test]
+    fn the_lanes_are_the_general_batch_to_the_bit_under_delta_lights_too() {
+        let emitters = r#"<emitter type="constant"><rgb name="radiance" value="0.1, 0.1, 0.2"/></emitter>
+            <emitter type="point"><point name="position" x="-1" y="1" z="1.5"/><rgb name="intensity" value="3, 2, 1"/></emitter>
+            <emitter type="spot"><transform name="to_world"><lookat origin="1, -1, 3" target="0, 0, 0" up="0, 0, 1"/></transform>
+                <rgb name="intensity" value="6, 7, 9"/><float name="cutoff_angle" value="25"/></emitter>
+            <emitter type="directional"><vector name="direction" x="0.4" y="0.3" z="-1"/><rgb name="irradiance" value="0.6, 0.5, 0.4"/></emitter>"#;
+        let world = scene_under("plain-lanes-delta", &format!("{emitters}{AREA_LIGHTS}"));
+        assert_eq!(world.lights.delta.len(), 3);
+        compare_batches(&world, &guides(Arc::new(EnvironmentPartition::uniform(8))));
     }
 
     /// Lit by area lights alone: a direction from the BSDF that meets none brings nothing.
