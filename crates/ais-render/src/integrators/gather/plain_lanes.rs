@@ -116,6 +116,8 @@ struct Lanes {
     source: [Source; RUN],
     /// Whether a direction was drawn and lies inside the BSDF's support.
     kept: [bool; RUN],
+    /// Whether a direction was drawn.
+    drawn: [bool; RUN],
     /// Whether its shadow ray was traced and is free.
     free: [bool; RUN],
     /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
@@ -131,9 +133,25 @@ impl Default for Lanes {
             location: [None; RUN],
             source: [Source::Unknown; RUN],
             kept: [false; RUN],
+            drawn: [false; RUN],
             free: [false; RUN],
             specular: [None; RUN],
         }
+    }
+}
+
+impl Lanes {
+    /// Candidate `k` drawn toward `toward`, which meets `source` first (kept only where
+    /// the lanes keep sources, `SOURCES`).
+    #[inline]
+    fn put<const SOURCES: bool>(&mut self, k: usize, toward: &Toward, source: Source) {
+        self.direction[k] = toward.direction;
+        self.location[k] = toward.map_location();
+        if SOURCES {
+            self.source[k] = source;
+        }
+        self.specular[k] = toward.specular;
+        self.drawn[k] = true;
     }
 }
 
@@ -175,8 +193,8 @@ impl<'a> PlainLanes<'a> {
         counts: &mut RayCounts,
         total: &mut PlainSum,
     ) {
-        // Compiled twice: lit by the environment alone, the lanes keep no sources (each
-        // step's work on them measured 2% of a frame in scenes lit by a sky).
+        // Compiled twice: lit by the environment alone, the lanes keep no sources (keeping
+        // them cost scenes lit by a sky about 2% of a frame).
         match self.sources {
             true => self.run_lanes::<true>(run, numbers, counts, total),
             false => self.run_lanes::<false>(run, numbers, counts, total),
@@ -229,61 +247,43 @@ impl<'a> PlainLanes<'a> {
         let mut bsdf_numbers = [[0.0; 2]; RUN];
         let mut bsdf_slots = [0; RUN];
         let mut bsdf_draws = 0;
-        let mut drawn = [false; RUN];
-        // What a BSDF-drawn direction meets: looked for later where area lights could be
-        // in the way.
-        // (Lit by the environment alone, the lanes keep no sources: all meet it.)
-        let bsdf_source = Source::Unknown;
-        let mut made = |k: usize, toward: &Toward, source: Source, drawn: &mut [bool; RUN]| {
-            lanes.direction[k] = toward.direction;
-            lanes.location[k] = toward.map_location();
-            if SOURCES {
-                lanes.source[k] = source;
-            }
-            lanes.specular[k] = toward.specular;
-            drawn[k] = true;
-        };
+        lanes.drawn = [false; RUN];
+        // A BSDF-drawn direction's source is found later, with the run's others ([`meet`]).
         for (k, &u) in numbers.iter().enumerate() {
-            let u = match MisPick::of(self.share, u) {
-                MisPick::Bsdf(u) => {
-                    match &self.diffuse {
-                        Some(frame) => {
-                            let toward = Toward::new(diffuse_direction(frame, u));
-                            made(k, &toward, bsdf_source, &mut drawn);
-                        }
-                        None => {
-                            (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
-                            bsdf_draws += 1;
-                        }
-                    }
+            let u = match (MisPick::of(self.share, u), &self.diffuse) {
+                (MisPick::Bsdf(u), Some(frame)) => {
+                    let toward = Toward::new(diffuse_direction(frame, u));
+                    lanes.put::<SOURCES>(k, &toward, Source::Unknown);
                     continue;
                 }
-                MisPick::Light(u) => u,
+                (MisPick::Bsdf(u), None) => {
+                    (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
+                    bsdf_draws += 1;
+                    continue;
+                }
+                (MisPick::Light(u), _) => u,
             };
             match at.lights.begin_sample(&at.receiver, u) {
                 Draw::Environment(u) => environment.push(k, u),
                 Draw::Rectangle(draw) => rectangles.push(k, draw),
-                Draw::Made(toward) => {
-                    if let Some(toward) = toward {
-                        made(k, &toward, toward.source(), &mut drawn);
-                    }
-                }
+                Draw::Made(Some(toward)) => lanes.put::<SOURCES>(k, &toward, toward.source()),
+                Draw::Made(None) => {}
             }
         }
         let receiver = &at.receiver;
         environment.draw(at.lights, receiver, |k, toward| {
-            made(k, &toward, Source::Environment, &mut drawn);
+            lanes.put::<SOURCES>(k, &toward, Source::Environment);
         });
         rectangles.draw(at.lights, receiver, |k, toward| {
-            made(k, &toward, toward.source(), &mut drawn);
+            lanes.put::<SOURCES>(k, &toward, toward.source());
         });
         at.draw_bsdf_run(&bsdf_numbers[..bsdf_draws], |i, toward| {
             if let Some(toward) = toward {
-                made(bsdf_slots[i], &toward, bsdf_source, &mut drawn);
+                lanes.put::<SOURCES>(bsdf_slots[i], &toward, Source::Unknown);
             }
         });
-        for (k, &drawn) in drawn[..numbers.len()].iter().enumerate() {
-            lanes.kept[k] = drawn
+        for (k, kept) in lanes.kept[..numbers.len()].iter_mut().enumerate() {
+            *kept = lanes.drawn[k]
                 && (lanes.specular[k].is_some() || at.bsdf.in_support(at.wo, lanes.direction[k]));
         }
     }
