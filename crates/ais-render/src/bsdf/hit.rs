@@ -10,7 +10,7 @@
 //! behind, not the surfaces).
 
 use super::tilted_normals::Tilt;
-use super::{BsdfSample, Material, ShadingFrame, SpecularMass};
+use super::{BsdfSample, DiffuseHit, Material, ShadingFrame, SpecularMass};
 use glam::Vec3;
 use std::borrow::Cow;
 
@@ -130,6 +130,16 @@ impl HitBsdf<'_> {
             }) => (direction, self.pdf(wo, direction)),
             Some(BsdfSample { direction, .. }) => (direction, 0.0),
             None => (-wo, 0.0),
+        }
+    }
+
+    /// A single diffuse material, seen from `wo`, for many directions' numbers at once
+    /// (`None` for other BSDFs).
+    #[inline]
+    pub fn diffuse(&self, wo: Vec3) -> Option<DiffuseHit> {
+        match self {
+            HitBsdf::Single { material, frame } => DiffuseHit::new(material, frame, wo),
+            HitBsdf::Mixture(_) => None,
         }
     }
 

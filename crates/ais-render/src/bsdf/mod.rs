@@ -3,6 +3,7 @@
 //! `twosided` adapter, and Mitsuba's `principled` and `principledthin`, each evaluating as Mitsuba 3 does.
 
 mod conductors;
+mod diffuse_hit;
 mod hit;
 mod microfacet;
 mod parameter_textures;
@@ -18,6 +19,7 @@ mod surface_reader;
 mod tilted_normals;
 
 pub use conductors::named_conductor;
+pub use diffuse_hit::DiffuseHit;
 pub use hit::{HitBsdf, Mixture, MixturePart};
 pub use microfacet::{fresnel_conductor, fresnel_dielectric, Microfacet, MicrofacetKind};
 pub(crate) use parameter_textures::parameter_texture;
@@ -344,6 +346,14 @@ impl Material {
     /// normal whatever the viewing direction ([`diffuse_direction`]).
     pub fn is_diffuse(&self) -> bool {
         matches!(self.scattering, Scattering::Diffuse { .. })
+    }
+
+    /// A diffuse material's reflectance (`None` for other materials).
+    pub fn diffuse_reflectance(&self) -> Option<Vec3> {
+        match self.scattering {
+            Scattering::Diffuse { reflectance } => Some(reflectance),
+            _ => None,
+        }
     }
 
     /// A direction drawn from the BSDF for viewing direction `wo`: from its continuous part,

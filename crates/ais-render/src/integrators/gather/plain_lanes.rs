@@ -11,7 +11,7 @@ use super::batch_loop::{BatchRun, PlainSum};
 use super::light::shadow_ray;
 use super::shared_origin::SharedOrigin;
 use super::strategy::{MisParts, MisPick, Strategy};
-use crate::bsdf::{diffuse_direction, ShadingFrame, SpecularMass};
+use crate::bsdf::{diffuse_direction, DiffuseHit, SpecularMass};
 use crate::lights::{
     Aim, Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap, MapLocation,
     MapWeights, Receiver, RectangleDraws, Source, Toward, LANES,
@@ -35,9 +35,9 @@ pub(super) struct PlainLanes<'a> {
     /// Whether there are lights besides the environment: without them, every candidate
     /// meets the environment, and no shaft bounds any ray.
     sources: bool,
-    /// A single diffuse material's frame, whose draws are made here (other BSDFs are asked
-    /// for theirs).
-    diffuse: Option<ShadingFrame>,
+    /// A single diffuse material, whose draws and numbers are worked out here (other BSDFs
+    /// are asked for theirs).
+    diffuse: Option<DiffuseHit>,
 }
 
 /// The environment, as the lanes look it up.
@@ -177,7 +177,7 @@ impl<'a> PlainLanes<'a> {
         };
         Some(PlainLanes {
             sky,
-            diffuse: at.bsdf.diffuse_frame().copied(),
+            diffuse: at.bsdf.diffuse(at.wo),
             share: at.mis_bsdf_share,
             choice,
             sources: !(lights.area.is_empty() && lights.delta.is_empty()),
@@ -251,8 +251,8 @@ impl<'a> PlainLanes<'a> {
         // A BSDF-drawn direction's source is found later, with the run's others ([`meet`]).
         for (k, &u) in numbers.iter().enumerate() {
             let u = match (MisPick::of(self.share, u), &self.diffuse) {
-                (MisPick::Bsdf(u), Some(frame)) => {
-                    let toward = Toward::new(diffuse_direction(frame, u));
+                (MisPick::Bsdf(u), Some(diffuse)) => {
+                    let toward = Toward::new(diffuse_direction(&diffuse.frame, u));
                     lanes.put::<SOURCES>(k, &toward, Source::Unknown);
                     continue;
                 }
@@ -283,8 +283,12 @@ impl<'a> PlainLanes<'a> {
             }
         });
         for (k, kept) in lanes.kept[..numbers.len()].iter_mut().enumerate() {
-            *kept = lanes.drawn[k]
-                && (lanes.specular[k].is_some() || at.bsdf.in_support(at.wo, lanes.direction[k]));
+            let direction = lanes.direction[k];
+            let in_support = match &self.diffuse {
+                Some(diffuse) => diffuse.in_support(direction),
+                None => at.bsdf.in_support(at.wo, direction),
+            };
+            *kept = lanes.drawn[k] && (lanes.specular[k].is_some() || in_support);
         }
     }
 
@@ -307,18 +311,29 @@ impl<'a> PlainLanes<'a> {
             (&Source::Delta(delta, arrival), _) => {
                 // A point mass of light sampling, which the BSDF's density does not add to.
                 let pdf = (1.0 - self.share) * at.lights.delta_choice(&at.receiver, delta);
-                return weighed(at.bsdf.eval(at.wo, direction), arrival.light, pdf);
+                let eval = match &self.diffuse {
+                    Some(diffuse) => diffuse.eval_and_pdf(direction).0,
+                    None => at.bsdf.eval(at.wo, direction),
+                };
+                return weighed(eval, arrival.light, pdf);
             }
             _ => unreachable!("a free ray meets a light or the environment"),
         };
         let (scattering, pdf) = match lanes.specular[k] {
             Some(mass) => (mass.weight, self.share * mass.probability as f64),
             None => {
+                let (eval, bsdf) = match &self.diffuse {
+                    Some(diffuse) => diffuse.eval_and_pdf(direction),
+                    None => (
+                        at.bsdf.eval(at.wo, direction),
+                        at.bsdf.pdf(at.wo, direction),
+                    ),
+                };
                 let parts = MisParts {
-                    bsdf: at.bsdf.pdf(at.wo, direction),
+                    bsdf,
                     light: light_density,
                 };
-                (at.bsdf.eval(at.wo, direction), parts.mixed(self.share))
+                (eval, parts.mixed(self.share))
             }
         };
         weighed(scattering, radiance, pdf)
