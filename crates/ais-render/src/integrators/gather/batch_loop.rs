@@ -217,8 +217,8 @@ fn trace_run(
 /// traced and added up in runs of [`AHEAD`] as [`run_ahead`] does, but with no call into
 /// the driver per candidate. The same estimate and counts, to the bit. Each candidate's
 /// value goes to `spread` where given.
-/// A batch that MIS draws, lit by area lights and an environment, runs lane by lane
-/// ([`PlainLanes`]): the same estimate, without the general candidate's bookkeeping.
+/// A batch that MIS draws from an unguided proposal runs lane by lane ([`PlainLanes`]),
+/// whatever its lights: the same estimate, without the general candidate's bookkeeping.
 fn run_plain(
     run: &BatchRun,
     batch: &mut Batch<[f32; 3]>,
@@ -238,7 +238,8 @@ fn run_plain(
 }
 
 /// The general runs of [`run_plain`]: `numbers`' candidates drawn, traced and added up
-/// into `total`.
+/// into `total` (for proposals that fold in a map, strategies other than MIS, and guides
+/// whose texels split a map's cells, which the lanes do not take).
 pub(super) fn add_up_plain(
     run: &BatchRun,
     numbers: &[[f32; 2]],
