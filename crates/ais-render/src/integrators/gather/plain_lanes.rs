@@ -414,7 +414,7 @@ mod tests {
     use super::*;
     use crate::geometry::Ray;
     use crate::image_io::{write_exr, RgbImage};
-    use crate::lights::{EnvironmentPartition, GuideLayout, RegionChoice, REGIONS};
+    use crate::lights::{EnvironmentPartition, GuideLayout, Lights, RegionChoice, REGIONS};
     use crate::scene::load_scene;
     use crate::world::World;
     use ais::rng::Pcg32;
@@ -461,22 +461,27 @@ mod tests {
         guides.map(Some)
     }
 
+    /// A field cell's learned choice of `lights` (none chosen by power) and of the first
+    /// area light's regions, if there is one.
+    fn learned_choices(lights: &Lights) -> (AliasTable, Vec<Option<RegionChoice>>) {
+        let choice_weights: Vec<f64> = (0..lights.source_count())
+            .map(|l| 0.2 + (l % 3) as f64)
+            .collect();
+        let region_weights: [f64; REGIONS] = std::array::from_fn(|r| 0.5 + (r % 4) as f64);
+        let mut region_choices = vec![None; lights.area.len()];
+        if let Some(first) = region_choices.first_mut() {
+            *first = RegionChoice::new(&region_weights);
+        }
+        (AliasTable::new(&choice_weights), region_choices)
+    }
+
     /// Compares the lanes with the general runs at 400 gather points of `world` seen from
     /// above, lit and in shadow, for several MIS shares and batch sizes, unguided and with
     /// each of `guides`, the lights chosen by power and by a cell's learned choice (with
     /// the first area light's regions weighed, where there is one): their estimates,
     /// counts and spreads must be the same to the bit.
     fn compare_batches(world: &World, guides: &[Option<EnvironmentGuide>; 2]) {
-        let lights = &world.lights;
-        let choice_weights: Vec<f64> = (0..lights.source_count())
-            .map(|l| 0.2 + (l % 3) as f64)
-            .collect();
-        let light_choice = AliasTable::new(&choice_weights);
-        let region_weights: [f64; REGIONS] = std::array::from_fn(|r| 0.5 + (r % 4) as f64);
-        let mut region_choices = vec![None; lights.area.len()];
-        if let Some(first) = region_choices.first_mut() {
-            *first = RegionChoice::new(&region_weights);
-        }
+        let (light_choice, region_choices) = learned_choices(&world.lights);
         let settings = GatherSettings::default();
         let sampler = CandidateSampler::plain(Strategy::Mis);
         let mut batch = Batch::<[f32; 3]>::new(BatchConfig::off()).unwrap();
