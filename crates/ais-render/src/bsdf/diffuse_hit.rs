@@ -37,21 +37,31 @@ impl DiffuseHit {
         self.faces_viewer && self.frame.normal.dot(wi) > 0.0 && self.frame.geometric.dot(wi) > 0.0
     }
 
-    /// The BSDF times |cos θi| at `wi` ([`Material::eval`]) and the density of its draws
-    /// there ([`Material::pdf`]).
+    /// The BSDF times |cos θi| at `wi` ([`Material::eval`]).
+    #[inline]
+    pub fn eval(&self, wi: Vec3) -> Vec3 {
+        match self.in_support(wi) {
+            true => self.reflectance * (self.cosine(wi) / PI),
+            false => Vec3::ZERO,
+        }
+    }
+
+    /// [`DiffuseHit::eval`] and the density of the material's draws at `wi`
+    /// ([`Material::pdf`]).
     #[inline]
     pub fn eval_and_pdf(&self, wi: Vec3) -> (Vec3, f64) {
-        // The local frame's z of `wi`, as `ShadingFrame::to_local` works it out.
-        let cosine = wi.dot(self.frame.normal);
-        let eval = match self.in_support(wi) {
-            true => self.reflectance * (cosine / PI),
-            false => Vec3::ZERO,
-        };
+        let cosine = self.cosine(wi);
         let pdf = match cosine <= 0.0 {
             true => 0.0,
             false => (cosine / PI) as f64,
         };
-        (eval, pdf)
+        (self.eval(wi), pdf)
+    }
+
+    /// The local frame's z of `wi`, as `ShadingFrame::to_local` works it out.
+    #[inline]
+    fn cosine(&self, wi: Vec3) -> f32 {
+        wi.dot(self.frame.normal)
     }
 }
 

@@ -345,7 +345,7 @@ impl Material {
     /// Whether the BSDF is diffuse: its draws are then cosine-weighted around the shading
     /// normal whatever the viewing direction ([`diffuse_direction`]).
     pub fn is_diffuse(&self) -> bool {
-        matches!(self.scattering, Scattering::Diffuse { .. })
+        self.diffuse_reflectance().is_some()
     }
 
     /// A diffuse material's reflectance (`None` for other materials).

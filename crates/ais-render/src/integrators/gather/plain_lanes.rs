@@ -283,11 +283,7 @@ impl<'a> PlainLanes<'a> {
             }
         });
         for (k, kept) in lanes.kept[..numbers.len()].iter_mut().enumerate() {
-            let direction = lanes.direction[k];
-            let in_support = match &self.diffuse {
-                Some(diffuse) => diffuse.in_support(direction),
-                None => at.bsdf.in_support(at.wo, direction),
-            };
+            let in_support = self.in_support(run, lanes.direction[k]);
             *kept = lanes.drawn[k] && (lanes.specular[k].is_some() || in_support);
         }
     }
@@ -311,24 +307,14 @@ impl<'a> PlainLanes<'a> {
             (&Source::Delta(delta, arrival), _) => {
                 // A point mass of light sampling, which the BSDF's density does not add to.
                 let pdf = (1.0 - self.share) * at.lights.delta_choice(&at.receiver, delta);
-                let eval = match &self.diffuse {
-                    Some(diffuse) => diffuse.eval_and_pdf(direction).0,
-                    None => at.bsdf.eval(at.wo, direction),
-                };
-                return weighed(eval, arrival.light, pdf);
+                return weighed(self.bsdf_value(run, direction), arrival.light, pdf);
             }
             _ => unreachable!("a free ray meets a light or the environment"),
         };
         let (scattering, pdf) = match lanes.specular[k] {
             Some(mass) => (mass.weight, self.share * mass.probability as f64),
             None => {
-                let (eval, bsdf) = match &self.diffuse {
-                    Some(diffuse) => diffuse.eval_and_pdf(direction),
-                    None => (
-                        at.bsdf.eval(at.wo, direction),
-                        at.bsdf.pdf(at.wo, direction),
-                    ),
-                };
+                let (eval, bsdf) = self.bsdf_value_and_density(run, direction);
                 let parts = MisParts {
                     bsdf,
                     light: light_density,
@@ -337,6 +323,40 @@ impl<'a> PlainLanes<'a> {
             }
         };
         weighed(scattering, radiance, pdf)
+    }
+
+    /// Whether light along `direction` reaches the viewer through the BSDF's continuous
+    /// part: from the diffuse material's numbers where there is one, else asked of the BSDF.
+    #[inline]
+    fn in_support(&self, run: &BatchRun, direction: Vec3) -> bool {
+        match &self.diffuse {
+            Some(diffuse) => diffuse.in_support(direction),
+            None => run.at.bsdf.in_support(run.at.wo, direction),
+        }
+    }
+
+    /// The BSDF times the cosine toward `direction` ([`PlainLanes::in_support`]'s sources).
+    #[inline]
+    fn bsdf_value(&self, run: &BatchRun, direction: Vec3) -> Vec3 {
+        match &self.diffuse {
+            Some(diffuse) => diffuse.eval(direction),
+            None => run.at.bsdf.eval(run.at.wo, direction),
+        }
+    }
+
+    /// [`PlainLanes::bsdf_value`] and the density of the BSDF's draws toward `direction`.
+    #[inline]
+    fn bsdf_value_and_density(&self, run: &BatchRun, direction: Vec3) -> (Vec3, f64) {
+        match &self.diffuse {
+            Some(diffuse) => diffuse.eval_and_pdf(direction),
+            None => {
+                let at = run.at;
+                (
+                    at.bsdf.eval(at.wo, direction),
+                    at.bsdf.pdf(at.wo, direction),
+                )
+            }
+        }
     }
 }
 
