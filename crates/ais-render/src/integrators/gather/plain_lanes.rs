@@ -335,7 +335,8 @@ impl<'a> PlainLanes<'a> {
         }
     }
 
-    /// The BSDF times the cosine toward `direction` ([`PlainLanes::in_support`]'s sources).
+    /// The BSDF times the cosine toward `direction`, from the same numbers as
+    /// [`PlainLanes::in_support`].
     #[inline]
     fn bsdf_value(&self, run: &BatchRun, direction: Vec3) -> Vec3 {
         match &self.diffuse {
