@@ -116,7 +116,6 @@ pub fn run_batch<P: BatchProbe>(
     mut lessons: Lessons,
 ) -> Vec3 {
     probe.started();
-    batch.begin(run.rays, run.seed, run.start);
     // Without a map or observations, nothing reads what a traced ray saw but its value and
     // (for a recorder) whether it was free: a blocked ray can skip the lookups its value
     // would need.
@@ -133,8 +132,11 @@ pub fn run_batch<P: BatchProbe>(
         && lessons.cell.is_none()
         && lessons.shares.is_none();
     let estimate = if plain {
+        // A plain batch begins with its own numbers ([`Batch::begin_plain`]): `begin`'s
+        // scramble of an epoch would be thrown away.
         run_plain(run, batch, counts, lessons.spread.as_deref_mut())
     } else {
+        batch.begin(run.rays, run.seed, run.start);
         if ahead {
             run_ahead(run, batch, counts, &mut lessons);
         } else {
