@@ -519,8 +519,9 @@ impl Geometry {
                 }
                 blockers.missed(tried);
                 let blocker = bvh.blocker(ray, blocks);
-                if let Some(index) = blocker {
-                    blockers.remember(index, bvh.near_test(index));
+                match blocker {
+                    Some(index) => blockers.remember(index, bvh.near_test(index)),
+                    None => blockers.note_free(),
                 }
                 blocker.is_some()
             }

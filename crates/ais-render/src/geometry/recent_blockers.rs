@@ -2,9 +2,14 @@
 
 /// The primitives that blocked a gather's rays (rays that share an origin), for
 /// [`super::Geometry::occluded_after`] to try before a traversal: the blocked rays of a
-/// gather in a room mostly meet the same few surfaces (walls, a ceiling). Start a new one
-/// for each origin: it only saves time, and a fresh one per gather keeps the work
-/// independent of the thread count.
+/// gather in a room mostly meet the same few surfaces (walls, a ceiling). It only saves
+/// time: whatever it holds, the answers are a traversal's.
+///
+/// A gather whose rays were mostly blocked passes its blockers on to the next gather of
+/// its tile, a neighbour, which then likely meets the same surfaces from its first ray
+/// ([`RecentBlockers::passed_on`]); one whose rays were mostly free passes on nothing, as
+/// its blockers would cost a test for each of the next gather's free rays. Tiles are the
+/// same whatever the thread count, and so is the work.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct RecentBlockers {
     /// Blocking primitives, the most recently useful first, no two that make the same test.
@@ -15,6 +20,9 @@ pub struct RecentBlockers {
     /// those are tried only while they pay.
     later_tests: u32,
     later_hits: u32,
+    /// The gather's rays that were blocked, and those that were free.
+    blocked: u32,
+    free: u32,
 }
 
 /// A primitive that blocked a ray.
@@ -47,8 +55,28 @@ impl RecentBlockers {
         }
     }
 
+    /// What the next gather of the tile starts from: these blockers and what their tests
+    /// paid, if at least half of the rays were blocked (where fewer were, trying them
+    /// would cost a free ray more than a blocked one saves), and nothing otherwise.
+    pub fn passed_on(&self) -> Self {
+        if self.blocked == 0 || self.blocked < self.free {
+            return RecentBlockers::default();
+        }
+        RecentBlockers {
+            blocked: 0,
+            free: 0,
+            ..*self
+        }
+    }
+
+    /// A ray was found free (by a traversal, or without one: a shaft's answer).
+    pub fn note_free(&mut self) {
+        self.free += 1;
+    }
+
     /// `recent[at]` blocked the ray: it moves to the front.
     pub(super) fn blocked_by(&mut self, at: usize) {
+        self.blocked += 1;
         if at > 0 {
             self.later_tests += at as u32;
             self.later_hits += 1;
@@ -66,10 +94,12 @@ impl RecentBlockers {
         self.recent[at].index as usize
     }
 
-    /// A blocker found by traversal, with what names its test (the same for primitives
-    /// tested together), put at the front in the place of one that makes the same test;
-    /// the oldest drops out when all places are taken.
+    /// A ray was blocked by a primitive that a traversal found: the blocker, with what
+    /// names its test (the same for primitives tested together), put at the front in the
+    /// place of one that makes the same test; the oldest drops out when all places are
+    /// taken.
     pub(super) fn remember(&mut self, index: usize, test: u32) {
+        self.blocked += 1;
         let known = self.recent[..self.len].iter().position(|k| k.test == test);
         let at = known.unwrap_or_else(|| {
             self.len = (self.len + 1).min(RECENT_BLOCKERS);
@@ -154,5 +184,30 @@ mod tests {
         assert_eq!(blockers.how_many_to_try(), 3);
         blockers.missed(3);
         assert_eq!(blockers.how_many_to_try(), 1);
+    }
+
+    #[test]
+    fn a_gather_passes_its_blockers_on_when_half_its_rays_or_more_were_blocked() {
+        let mut blockers = RecentBlockers::default();
+        assert_eq!(blockers.passed_on().len, 0, "no ray, nothing to pass on");
+        remember(&mut blockers, 0);
+        remember(&mut blockers, 8);
+        blockers.missed(2);
+        blockers.note_free();
+        // Two blocked, one free: the blockers and what their tests paid go on, and the
+        // next gather counts its own rays afresh.
+        let next = blockers.passed_on();
+        assert_eq!((next.len, next.index(0), next.index(1)), (2, 8, 0));
+        assert_eq!(next.later_tests, blockers.later_tests);
+        assert_eq!((next.blocked, next.free), (0, 0));
+        // As many free as blocked still passes them on; one more free ray does not.
+        blockers.note_free();
+        assert_eq!(blockers.passed_on().len, 2);
+        blockers.note_free();
+        let next = blockers.passed_on();
+        assert_eq!((next.len, next.later_tests, next.blocked), (0, 0, 0));
+        // A ray blocked by a blocker tried first counts as blocked too.
+        blockers.blocked_by(0);
+        assert_eq!(blockers.passed_on().len, 2);
     }
 }

@@ -67,6 +67,7 @@ pub fn snapshots(
         start: ais::MapStart::Empty,
         field: None,
         clock: None,
+        blockers: &std::cell::Cell::default(),
     };
     run_batch(
         &run,

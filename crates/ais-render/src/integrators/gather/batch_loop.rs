@@ -64,6 +64,21 @@ pub struct BatchRun<'a> {
     pub field: Option<FieldUse<'a>>,
     /// When given, the time spent on accepted candidates is added to it.
     pub clock: Option<&'a Cell<Duration>>,
+    /// What blocked the shadow rays of the tile's gather before this one, which it passed
+    /// on ([`SharedOrigin::passed_on`]); this batch passes on its own.
+    pub blockers: &'a Cell<RecentBlockers>,
+}
+
+impl BatchRun<'_> {
+    /// The batch's shadow rays, starting from the blockers passed on to it.
+    pub(super) fn shared_origin(&self) -> SharedOrigin {
+        SharedOrigin::after(self.blockers.get())
+    }
+
+    /// Passes on what `origin`, the batch's shadow rays, met to the tile's next gather.
+    pub(super) fn pass_on(&self, origin: &SharedOrigin) {
+        self.blockers.set(origin.passed_on());
+    }
 }
 
 /// The field's cell for one gather, and the cost ratio its acceptance uses.
@@ -168,10 +183,11 @@ fn run_ahead(
     let mut drawn = [None; AHEAD];
     let mut weights = [1.0; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
-    let mut origin = SharedOrigin::default();
+    let mut origin = run.shared_origin();
     loop {
         let count = draw_ahead(run, batch, &mut drawn, &mut weights);
         if count == 0 {
+            run.pass_on(&origin);
             return;
         }
         let shadow_rays = ShadowRays {
@@ -250,7 +266,7 @@ pub(super) fn add_up_plain(
 ) {
     let mut drawn = [None; AHEAD];
     let mut arriving = [ShadowRay::Unneeded; AHEAD];
-    let mut origin = SharedOrigin::default();
+    let mut origin = run.shared_origin();
     for numbers in numbers.chunks(AHEAD) {
         let drawn = &mut drawn[..numbers.len()];
         draw_into(run, numbers, drawn);
@@ -265,6 +281,7 @@ pub(super) fn add_up_plain(
             total.add(plain_value_of(run, toward, arriving));
         }
     }
+    run.pass_on(&origin);
 }
 
 /// What a plain batch adds up: its traced candidates' values, how many it traced, and
@@ -410,7 +427,7 @@ fn run_one_by_one<P: BatchProbe>(
     let at = run.at;
     let value_only = batch.map().is_none() && batch.observations().is_none();
     let mut values = RunningMean::default();
-    let mut origin = SharedOrigin::default();
+    let mut origin = run.shared_origin();
     while let Some(candidate) = batch.next_candidate() {
         let Some(mut toward) = run.sampler.sample_direction(at, candidate.u) else {
             probe.decided(at.frame.normal, false);
@@ -434,6 +451,7 @@ fn run_one_by_one<P: BatchProbe>(
             probe.recorded(batch, traced.value.to_array(), traced.rating);
         }
     }
+    run.pass_on(&origin);
 }
 
 /// Records a traced candidate toward `toward` (weighed `weight` = 1 / acceptance) in the

@@ -592,6 +592,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         rays,
         spread,
         race,
+        blockers,
         ..
     } = state;
     // A pixel racing as AIS off records its rays but is not guided (see `race`).
@@ -624,6 +625,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         start: MapStart::Empty,
         field: rolling.map(|cell| FieldUse { cell, cost_ratio }),
         clock: timed.then_some(&clock),
+        blockers,
     };
     let batch = batch_for(batch, settings);
     let before = *batch.stats();

@@ -21,11 +21,13 @@ use super::batch_loop::{run_batch, BatchRun, Lessons};
 use super::guiding::CandidateSampler;
 use super::settings::{GatherSettings, MapSource, MapUse, Update};
 use super::strategy::gather_point;
+use crate::geometry::RecentBlockers;
 use crate::render::{PixelRect, RayCounts, Tile};
 use crate::world::World;
 use ais::rng::{mix64, Pcg32};
 use ais::shared::Neighbour;
 use ais::{Batch, MapStart};
+use std::cell::Cell;
 
 /// Seeds of learning gathers are drawn from a domain apart from the pixels' seeds, so that a
 /// pixel's gather never reuses the random numbers its map was learned from.
@@ -36,6 +38,8 @@ const SEED_DOMAIN: u64 = 0x6c65_6172_6e20_7061;
 pub struct LearningPass {
     cells: Vec<Neighbour>,
     batch: Option<Batch<[f32; 3]>>,
+    /// What blocked the last learning gather's shadow rays, passed on to the next.
+    blockers: Cell<RecentBlockers>,
 }
 
 /// The blocks a tile's learning pass covers: the tile's and one around it.
@@ -144,6 +148,7 @@ impl LearningPass {
             start: MapStart::Empty,
             field: None,
             clock: None,
+            blockers: &self.blockers,
         };
         run_batch(&run, batch, counts, &mut (), Lessons::default());
         let observations = batch

@@ -35,7 +35,7 @@ pub use light::arriving_light;
 pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing, Update};
 pub use strategy::{gather_point, GatherPoint, Strategy};
 
-use crate::geometry::{Hit, Ray};
+use crate::geometry::{Hit, Ray, RecentBlockers};
 use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
 use ais::field::{CellIndex, CellKey, FieldObservations, VisibilityField};
@@ -49,6 +49,7 @@ use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
 use mis_share::ShareMoments;
 use race::{RaceResult, TileMoments};
+use std::cell::Cell;
 use std::sync::Arc;
 
 /// The radius of a gather's neighbourhood among the tile's recent gathers, in pixel
@@ -109,6 +110,8 @@ impl TileStats for GatherStats {
 pub struct GatherTile<P: BatchProbe = ()> {
     /// The batch driver (allocated on first use).
     pub(super) batch: Option<Batch<[f32; 3]>>,
+    /// What blocked the shadow rays of the tile's last gather, passed on to the next.
+    pub(super) blockers: Cell<RecentBlockers>,
     /// The tile's recent gathers, for shared maps in tile order.
     recent: RecentGathers,
     /// The learning pass around this tile, for shared maps from a learning pass.
@@ -195,6 +198,7 @@ impl<P: BatchProbe> GatherTile<P> {
         let measures = races || (race_pass && field::chooses_sizes(settings));
         let mut state = GatherTile {
             batch: None,
+            blockers: Cell::default(),
             recent: RecentGathers::default(),
             learned: LearningPass::default(),
             guide: None,
@@ -514,6 +518,7 @@ fn map_gather<P: BatchProbe>(
         start,
         field: None,
         clock: None,
+        blockers: &state.blockers,
     };
     let lessons = Lessons {
         spread: state.spread.as_mut(),

@@ -209,7 +209,7 @@ impl<'a> PlainLanes<'a> {
         counts: &mut RayCounts,
         total: &mut PlainSum,
     ) {
-        let mut origin = SharedOrigin::default();
+        let mut origin = run.shared_origin();
         let mut lanes = Lanes::default();
         for numbers in numbers.chunks(RUN) {
             let count = numbers.len();
@@ -231,6 +231,7 @@ impl<'a> PlainLanes<'a> {
                 });
             }
         }
+        run.pass_on(&origin);
     }
 
     /// Draws the candidates of `numbers` into `lanes`: the map's all together
@@ -533,6 +534,7 @@ mod tests {
                 start: MapStart::Empty,
                 field: None,
                 clock: None,
+                blockers: &std::cell::Cell::default(),
             };
             let lanes = PlainLanes::of(&run).expect("lights the lanes take");
             let numbers = batch.begin_plain(run.rays, run.seed).to_vec();

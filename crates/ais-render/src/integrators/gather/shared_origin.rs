@@ -1,5 +1,7 @@
 //! What a gather's shadow rays, which share an origin, learn from one another: the blockers
-//! they met ([`RecentBlockers`]), and the lights toward which nothing can block them.
+//! they met ([`RecentBlockers`]), and the lights toward which nothing can block them. The
+//! blockers also go on to the tile's next gather where most of the rays were blocked
+//! ([`RecentBlockers::passed_on`]).
 //!
 //! Toward a rectangle or a sphere light, every ray from the gather's origin lies in one
 //! shaft ([`Shaft`]). Once a ray toward the light has come back free, and the run of
@@ -53,6 +55,20 @@ pub struct SharedOrigin {
 }
 
 impl SharedOrigin {
+    /// A gather's shadow rays, starting from the blockers an earlier gather passed on
+    /// ([`SharedOrigin::passed_on`]).
+    pub fn after(blockers: RecentBlockers) -> Self {
+        SharedOrigin {
+            blockers,
+            ..SharedOrigin::default()
+        }
+    }
+
+    /// What the tile's next gather starts from ([`RecentBlockers::passed_on`]).
+    pub fn passed_on(&self) -> RecentBlockers {
+        self.blockers.passed_on()
+    }
+
     /// Counts the rays toward each light in a run of candidates about to be traced
     /// (`drawn`, their sources found); without it, no shaft is asked about.
     pub fn expect_run(&mut self, world: &World, drawn: &[Option<Toward>]) {
@@ -98,10 +114,14 @@ impl SharedOrigin {
         let to_come = self.to_come[light];
         self.to_come[light] = to_come.saturating_sub(1);
         match self.shafts[light] {
-            ShaftState::Clear(apex) if apex == ray.origin => return false,
+            ShaftState::Clear(apex) if apex == ray.origin => {
+                self.blockers.note_free();
+                return false;
+            }
             ShaftState::Free if to_come >= RAYS_TO_COME_FOR_TEST => {
                 if shaft_is_clear(world, at, light, ray.origin) {
                     self.shafts[light] = ShaftState::Clear(ray.origin);
+                    self.blockers.note_free();
                     return false;
                 }
                 self.shafts[light] = ShaftState::Traced;
