@@ -65,7 +65,7 @@ pub struct BatchRun<'a> {
     /// When given, the time spent on accepted candidates is added to it.
     pub clock: Option<&'a Cell<Duration>>,
     /// What blocked the shadow rays of the tile's gather before this one, which it passed
-    /// on ([`SharedOrigin::passed_on`]); this batch passes on its own.
+    /// on ([`RecentBlockers::passed_on`]); this batch passes on its own.
     pub blockers: &'a Cell<RecentBlockers>,
 }
 
