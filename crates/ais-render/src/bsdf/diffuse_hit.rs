@@ -34,16 +34,13 @@ impl DiffuseHit {
     /// Whether light arriving along `wi` reaches the viewer ([`Material::in_support`]).
     #[inline]
     pub fn in_support(&self, wi: Vec3) -> bool {
-        self.faces_viewer && self.frame.normal.dot(wi) > 0.0 && self.frame.geometric.dot(wi) > 0.0
+        self.in_support_at(wi, self.cosine(wi))
     }
 
     /// The BSDF times |cos θi| at `wi` ([`Material::eval`]).
     #[inline]
     pub fn eval(&self, wi: Vec3) -> Vec3 {
-        match self.in_support(wi) {
-            true => self.reflectance * (self.cosine(wi) / PI),
-            false => Vec3::ZERO,
-        }
+        self.eval_at(wi, self.cosine(wi))
     }
 
     /// [`DiffuseHit::eval`] and the density of the material's draws at `wi`
@@ -55,10 +52,26 @@ impl DiffuseHit {
             true => 0.0,
             false => (cosine / PI) as f64,
         };
-        (self.eval(wi), pdf)
+        (self.eval_at(wi, cosine), pdf)
     }
 
-    /// The local frame's z of `wi`, as `ShadingFrame::to_local` works it out.
+    /// [`DiffuseHit::in_support`] for `wi`, whose cosine is `cosine`.
+    #[inline]
+    fn in_support_at(&self, wi: Vec3, cosine: f32) -> bool {
+        self.faces_viewer && cosine > 0.0 && self.frame.geometric.dot(wi) > 0.0
+    }
+
+    /// [`DiffuseHit::eval`] for `wi`, whose cosine is `cosine`.
+    #[inline]
+    fn eval_at(&self, wi: Vec3, cosine: f32) -> Vec3 {
+        match self.in_support_at(wi, cosine) {
+            true => self.reflectance * (cosine / PI),
+            false => Vec3::ZERO,
+        }
+    }
+
+    /// The local frame's z of `wi`, as `ShadingFrame::to_local` works it out (the normal's
+    /// dot product with it, the same products in the same order).
     #[inline]
     fn cosine(&self, wi: Vec3) -> f32 {
         wi.dot(self.frame.normal)

@@ -70,7 +70,7 @@ impl RecentBlockers {
     }
 
     /// A ray was found free (by a traversal, or without one: a shaft's answer).
-    pub fn note_free(&mut self) {
+    pub(crate) fn note_free(&mut self) {
         self.free += 1;
     }
 

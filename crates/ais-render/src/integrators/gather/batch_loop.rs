@@ -77,7 +77,7 @@ impl BatchRun<'_> {
 
     /// Passes on what `origin`, the batch's shadow rays, met to the tile's next gather.
     pub(super) fn pass_on(&self, origin: &SharedOrigin) {
-        self.blockers.set(origin.passed_on());
+        self.blockers.set(origin.blockers.passed_on());
     }
 }
 

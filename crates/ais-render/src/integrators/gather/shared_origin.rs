@@ -56,17 +56,12 @@ pub struct SharedOrigin {
 
 impl SharedOrigin {
     /// A gather's shadow rays, starting from the blockers an earlier gather passed on
-    /// ([`SharedOrigin::passed_on`]).
+    /// ([`RecentBlockers::passed_on`]).
     pub fn after(blockers: RecentBlockers) -> Self {
         SharedOrigin {
             blockers,
             ..SharedOrigin::default()
         }
-    }
-
-    /// What the tile's next gather starts from ([`RecentBlockers::passed_on`]).
-    pub fn passed_on(&self) -> RecentBlockers {
-        self.blockers.passed_on()
     }
 
     /// Counts the rays toward each light in a run of candidates about to be traced
