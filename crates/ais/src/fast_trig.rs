@@ -43,13 +43,37 @@ fn atan_unit(a: f32) -> f32 {
 /// atan2(y, x) in [−π, π], absolute error below 4e-7 rad; (0, 0) gives 0.
 #[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {
-    let (ax, ay) = (x.abs(), y.abs());
-    let (low, high) = (ax.min(ay), ax.max(ay));
+    let [low, high] = folded(y, x);
     if high == 0.0 {
         return 0.0;
     }
-    let mut r = atan_unit(low / high);
-    if ay > ax {
+    unfolded(atan_unit(low / high), y, x)
+}
+
+/// [`atan2`] of each lane, the same numbers lane by lane, in a form that the compiler runs
+/// in vector lanes: a select where [`atan2`] returns early (the polynomial gives 0 there,
+/// which the signs leave at +0). One by one, the early return is the faster.
+#[inline(always)]
+pub fn atan2_lanes<const N: usize>(y: &[f32; N], x: &[f32; N]) -> [f32; N] {
+    std::array::from_fn(|k| {
+        let [low, high] = folded(y[k], x[k]);
+        let ratio = if high == 0.0 { 0.0 } else { low / high };
+        unfolded(atan_unit(ratio), y[k], x[k])
+    })
+}
+
+/// The smaller and the larger of |x| and |y|: the arctangent of their ratio is the angle
+/// of (x, y) folded into [0, π/4].
+#[inline(always)]
+fn folded(y: f32, x: f32) -> [f32; 2] {
+    let (ax, ay) = (x.abs(), y.abs());
+    [ax.min(ay), ax.max(ay)]
+}
+
+/// The angle of (x, y) from its folded angle `r` ([`folded`]).
+#[inline(always)]
+fn unfolded(mut r: f32, y: f32, x: f32) -> f32 {
+    if y.abs() > x.abs() {
         r = FRAC_PI_2 - r;
     }
     if x < 0.0 {
@@ -66,7 +90,21 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 #[inline]
 pub fn acos(x: f32) -> f32 {
     let x = x.clamp(-1.0, 1.0);
-    atan2(((1.0 - x) * (1.0 + x)).sqrt(), x)
+    atan2(sine_of(x), x)
+}
+
+/// [`acos`] of each lane, the same numbers lane by lane, in vector lanes
+/// ([`atan2_lanes`]).
+#[inline(always)]
+pub fn acos_lanes<const N: usize>(x: &[f32; N]) -> [f32; N] {
+    let x = x.map(|x| x.clamp(-1.0, 1.0));
+    atan2_lanes(&x.map(sine_of), &x)
+}
+
+/// √(1 − x²) for a cosine `x` in [−1, 1], as (1 − x)(1 + x) keeps it accurate near ±1.
+#[inline(always)]
+fn sine_of(x: f32) -> f32 {
+    ((1.0 - x) * (1.0 + x)).sqrt()
 }
 
 /// Coefficients of sin(r) ≈ r + r³ · P(r²) on [−π/4, π/4], lowest degree first.
@@ -131,6 +169,52 @@ mod tests {
             worst = worst.max((acos(x) as f64 - exact).abs());
         }
         assert!(worst < 4e-7, "worst error {worst}");
+    }
+
+    #[test]
+    fn the_lanes_give_the_numbers_of_one_at_a_time() {
+        // Both signs, both zeros, the axes and the diagonals, tiny and huge values.
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            -0.5,
+            1e-30,
+            -1e-30,
+            3e30,
+            -3e30,
+            0.999_999_9,
+            std::f32::consts::FRAC_1_SQRT_2,
+        ];
+        let mut compared = 0;
+        for chunk in values.chunks(4) {
+            for &x in &values {
+                let ys: [f32; 4] = std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(0.0));
+                let xs = [x; 4];
+                let lanes = atan2_lanes(&ys, &xs);
+                for k in 0..4 {
+                    assert_eq!(
+                        lanes[k].to_bits(),
+                        atan2(ys[k], xs[k]).to_bits(),
+                        "{ys:?} {x}"
+                    );
+                    compared += 1;
+                }
+            }
+            let cosines: [f32; 4] = std::array::from_fn(|k| chunk.get(k).copied().unwrap_or(2.0));
+            let lanes = acos_lanes(&cosines);
+            for k in 0..4 {
+                assert_eq!(
+                    lanes[k].to_bits(),
+                    acos(cosines[k]).to_bits(),
+                    "{}",
+                    cosines[k]
+                );
+            }
+        }
+        assert_eq!(compared, 144);
     }
 
     #[test]

@@ -134,4 +134,25 @@ impl SampleIntegrator for Integrator {
             }
         }
     }
+
+    fn pixel_radiance(
+        &self,
+        world: &World,
+        rays: &[Ray],
+        rng: &mut Pcg32,
+        state: &mut IntegratorTile,
+        counts: &mut RayCounts,
+        values: &mut Vec<[f32; 3]>,
+    ) {
+        match (self, state) {
+            (Integrator::Gather(settings), IntegratorTile::Gather(state)) => {
+                gather::gather_samples(world, settings, rays, rng, state, counts, values)
+            }
+            (_, state) => {
+                for ray in rays {
+                    values.push(self.radiance(world, ray, rng, state, counts));
+                }
+            }
+        }
+    }
 }

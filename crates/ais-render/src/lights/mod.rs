@@ -20,6 +20,7 @@ mod toward;
 pub use area::{AreaHit, AreaLight, AreaSample, AreaShape, LightSpot};
 pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use draw::Draw;
+pub(crate) use environment::LANES as MAP_LANES;
 pub use environment::{luminance, Environment, EnvironmentMap, MapLocation};
 pub use environment_draws::EnvironmentDraws;
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout, MapWeights};

@@ -132,4 +132,21 @@ pub trait SampleIntegrator: Sync {
         state: &mut Self::Tile,
         counts: &mut RayCounts,
     ) -> [f32; 3];
+
+    /// The values of a pixel's camera `rays` (its samples, in order), pushed onto `values`:
+    /// [`SampleIntegrator::radiance`] of each, unless the integrator makes some of their
+    /// work together.
+    fn pixel_radiance(
+        &self,
+        world: &World,
+        rays: &[Ray],
+        rng: &mut Pcg32,
+        state: &mut Self::Tile,
+        counts: &mut RayCounts,
+        values: &mut Vec<[f32; 3]>,
+    ) {
+        for ray in rays {
+            values.push(self.radiance(world, ray, rng, state, counts));
+        }
+    }
 }

@@ -24,6 +24,7 @@ pub use integrator::{Learning, PassEnd, SampleIntegrator, TileState, TileStats};
 pub use tile::{pixel_seed, tiles, PixelRect, Tile, TILE_SIZE};
 
 use crate::film::{Film, ReconstructionFilter};
+use crate::geometry::Ray;
 use crate::image_io::RgbImage;
 use crate::world::World;
 use ais::rng::Pcg32;
@@ -319,6 +320,39 @@ impl<S: TileStats> Accumulated<S> {
 }
 
 /// Renders one pass of one tile with a fresh integrator state.
+/// A pixel's camera samples: where each falls on the image, and its camera ray.
+#[derive(Default)]
+struct PixelRays {
+    positions: Vec<[f32; 2]>,
+    rays: Vec<Ray>,
+}
+
+impl PixelRays {
+    /// The samples `ranks` of `pixel` in an image of `size`, in place of the last pixel's.
+    fn fill(
+        &mut self,
+        world: &World,
+        samples: &CameraSamples,
+        pixel: (usize, usize),
+        ranks: std::ops::Range<u32>,
+        size: (usize, usize),
+    ) {
+        self.positions.clear();
+        self.rays.clear();
+        for rank in ranks {
+            let [dx, dy] = samples.position(rank);
+            let position = [pixel.0 as f32 + dx, pixel.1 as f32 + dy];
+            let (u, v) = (position[0] / size.0 as f32, position[1] / size.1 as f32);
+            self.rays.push(if world.camera.has_aperture() {
+                world.camera.ray_through_lens(u, v, samples.lens(rank))
+            } else {
+                world.camera.ray(u, v)
+            });
+            self.positions.push(position);
+        }
+    }
+}
+
 fn render_tile<I: SampleIntegrator>(
     world: &World,
     integrator: &I,
@@ -329,32 +363,28 @@ fn render_tile<I: SampleIntegrator>(
     let started = Instant::now();
     let mut counts = RayCounts::default();
     let mut state = integrator.begin_tile(world, tile, learned, &mut counts);
-    let (width, height) = tile.image;
+    let width = tile.image.0;
     let spp = pass.samples;
     let filter = world.filter;
     let mut means = Vec::with_capacity(tile.rect.area());
     let mut splats = (filter != ReconstructionFilter::Box)
         .then(|| Film::covering(tile.rect.grown(filter.margin(), tile.image)));
     let mut work = Vec::with_capacity(tile.rect.area());
+    let (mut samples, mut values) = (PixelRays::default(), Vec::new());
     for (x, y) in tile.rect.pixels() {
         let own = pixel_seed(tile.seed, x, y, width);
         let mut rng = Pcg32::new(pass.generator_seed(own), 0);
-        let camera_samples = CameraSamples::new(own);
         let work_before = state.work();
         state.begin_pixel(x, y);
         let mut sum = [0.0f64; 3];
-        for rank in pass.first_sample..pass.first_sample + spp {
-            let [dx, dy] = camera_samples.position(rank);
-            let position = [x as f32 + dx, y as f32 + dy];
-            let (u, v) = (position[0] / width as f32, position[1] / height as f32);
-            let ray = if world.camera.has_aperture() {
-                world
-                    .camera
-                    .ray_through_lens(u, v, camera_samples.lens(rank))
-            } else {
-                world.camera.ray(u, v)
-            };
-            let value = integrator.radiance(world, &ray, &mut rng, &mut state, &mut counts);
+        // The pixel's camera rays first, then their values all together (an integrator
+        // may make some of their work together), then the film in the samples' order.
+        let ranks = pass.first_sample..pass.first_sample + spp;
+        samples.fill(world, &CameraSamples::new(own), (x, y), ranks, tile.image);
+        values.clear();
+        let rays = &samples.rays;
+        integrator.pixel_radiance(world, rays, &mut rng, &mut state, &mut counts, &mut values);
+        for (&value, &position) in values.iter().zip(&samples.positions) {
             state.sampled(value);
             match splats.as_mut() {
                 Some(film) => film.splat(&filter, position, value),

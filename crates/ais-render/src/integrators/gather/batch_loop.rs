@@ -9,6 +9,7 @@ use super::mis_share::ShareMoments;
 use super::plain_lanes::PlainLanes;
 use super::settings::GatherSettings;
 use super::shared_origin::SharedOrigin;
+use super::sky_pool::SkyPool;
 use super::strategy::{CandidateDraw, GatherPoint, MisParts};
 use crate::geometry::RecentBlockers;
 use crate::lights::{luminance, EnvironmentDraws, RectangleDraws, Toward};
@@ -17,7 +18,7 @@ use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
 use ais::{rating, Batch, BatchConfig, Decision, MapStart, PlainTally, Value};
 use glam::Vec3;
-use std::cell::Cell;
+use std::cell::{Cell, RefCell};
 use std::time::{Duration, Instant};
 
 /// Watches the calls a batch makes into the library, for studies (timing them, taking
@@ -67,6 +68,9 @@ pub struct BatchRun<'a> {
     /// What blocked the shadow rays of the tile's gather before this one, which it passed
     /// on ([`RecentBlockers::passed_on`]); this batch passes on its own.
     pub blockers: &'a Cell<RecentBlockers>,
+    /// Where a plain batch leaves its environment-map lookups for the pixel's gathers to
+    /// make together ([`SkyPool`]); `None`: it makes them itself.
+    pub sky_pool: Option<&'a RefCell<SkyPool>>,
 }
 
 impl BatchRun<'_> {

@@ -26,6 +26,7 @@ mod plain_lanes;
 pub mod race;
 pub mod settings;
 mod shared_origin;
+pub mod sky_pool;
 pub mod strategy;
 
 pub use acceptance::Acceptance;
@@ -36,6 +37,7 @@ pub use settings::{GatherSettings, MapSource, MapUse, Preset, RayBudget, Sharing
 pub use strategy::{gather_point, GatherPoint, Strategy};
 
 use crate::geometry::{Hit, Ray, RecentBlockers};
+use crate::lights::Environment;
 use crate::render::{RayCounts, Tile, TileState, TileStats};
 use crate::world::World;
 use ais::field::{CellIndex, CellKey, FieldObservations, VisibilityField};
@@ -49,7 +51,8 @@ use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
 use mis_share::ShareMoments;
 use race::{RaceResult, TileMoments};
-use std::cell::Cell;
+use sky_pool::SkyPool;
+use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
 /// The radius of a gather's neighbourhood among the tile's recent gathers, in pixel
@@ -112,6 +115,8 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) batch: Option<Batch<[f32; 3]>>,
     /// What blocked the shadow rays of the tile's last gather, passed on to the next.
     pub(super) blockers: Cell<RecentBlockers>,
+    /// The environment-map lookups of the pixel's gathers, made together ([`SkyPool`]).
+    pub(super) sky_pool: RefCell<SkyPool>,
     /// The tile's recent gathers, for shared maps in tile order.
     recent: RecentGathers,
     /// The learning pass around this tile, for shared maps from a learning pass.
@@ -199,6 +204,7 @@ impl<P: BatchProbe> GatherTile<P> {
         let mut state = GatherTile {
             batch: None,
             blockers: Cell::default(),
+            sky_pool: RefCell::default(),
             recent: RecentGathers::default(),
             learned: LearningPass::default(),
             guide: None,
@@ -453,6 +459,45 @@ pub fn gather<P: BatchProbe>(
     emitted + map_gather(world, settings, &site, at, state, counts)
 }
 
+/// The values of a pixel's camera `rays` (its samples, in order), pushed onto `values`:
+/// [`gather`] of each, with the environment-map lookups of AIS off's plain batches pooled
+/// across them and made together ([`SkyPool`]).
+pub fn gather_samples<P: BatchProbe>(
+    world: &World,
+    settings: &GatherSettings,
+    rays: &[Ray],
+    rng: &mut Pcg32,
+    state: &mut GatherTile<P>,
+    counts: &mut RayCounts,
+    values: &mut Vec<[f32; 3]>,
+) {
+    let first = values.len();
+    let map = match &world.lights.environment {
+        Some(Environment::Map(map)) => Some(map),
+        _ => None,
+    };
+    if map.is_some() {
+        state.sky_pool.get_mut().open();
+    }
+    for (sample, ray) in rays.iter().enumerate() {
+        state.sky_pool.get_mut().begin_sample(sample as u32);
+        values.push(gather(world, settings, ray, rng, state, counts).to_array());
+    }
+    if let Some(map) = map {
+        state.sky_pool.get_mut().resolve(map, &mut values[first..]);
+    }
+}
+
+/// Whether a gather of `state`'s may leave its environment-map lookups in the pixel's pool:
+/// while the pool is open, unless something reads the gather's candidates one by one (their
+/// spread, a race's moments, or a probe).
+fn pools_sky<P: BatchProbe>(state: &GatherTile<P>) -> bool {
+    state.sky_pool.borrow().is_open()
+        && state.spread.is_none()
+        && state.race.is_none()
+        && !P::WATCHES
+}
+
 /// Hands the variance of the gather just run, from its candidates' `spread`, to the pixel
 /// moments of a race pass (`race`), where both are kept.
 pub(super) fn note_gather_variance(
@@ -487,6 +532,7 @@ fn map_gather<P: BatchProbe>(
     // A guided gather points `at` at a guide borrowed from `state`: a shorter lifetime.
     let mut at: GatherPoint<'_> = at;
     let sharing = settings.shares_maps();
+    let pools_sky = pools_sky(state);
     let batch = batch_for(&mut state.batch, settings);
     let mut sampler = CandidateSampler::plain(settings.strategy);
     let start = if sharing {
@@ -519,6 +565,7 @@ fn map_gather<P: BatchProbe>(
         field: None,
         clock: None,
         blockers: &state.blockers,
+        sky_pool: pools_sky.then_some(&state.sky_pool),
     };
     let lessons = Lessons {
         spread: state.spread.as_mut(),

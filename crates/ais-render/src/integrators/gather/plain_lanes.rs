@@ -10,6 +10,7 @@
 use super::batch_loop::{BatchRun, PlainSum};
 use super::light::shadow_ray;
 use super::shared_origin::SharedOrigin;
+use super::sky_pool::SkyLookup;
 use super::strategy::{MisParts, MisPick, Strategy};
 use crate::bsdf::{diffuse_direction, DiffuseHit, SpecularMass};
 use crate::lights::{
@@ -299,6 +300,22 @@ impl<'a> PlainLanes<'a> {
             true => &lanes.source[k],
             false => &Source::Environment,
         };
+        if let (Source::Environment, Some(pool)) = (source, run.sky_pool) {
+            if let (Some(Sky::Map { guide: None, .. }), None) = (&self.sky, lanes.specular[k]) {
+                let (scattering, bsdf_density) = self.bsdf_value_and_density(run, direction);
+                pool.borrow_mut().leave(SkyLookup {
+                    direction,
+                    location: lanes.location[k],
+                    scattering,
+                    bsdf_density,
+                    choice: self.choice,
+                    share: self.share,
+                    weight: (1.0 / run.rays as f64) as f32,
+                });
+                // Its value is added to the sample's once the pixel's lookups are made.
+                return Vec3::ZERO;
+            }
+        }
         let (radiance, light_density) = match (source, &self.sky) {
             (Source::Area(point), _) => (point.radiance, point.density),
             (Source::Environment, Some(sky)) => {
@@ -366,7 +383,7 @@ impl<'a> PlainLanes<'a> {
 /// drawn with probability (density) `pdf`: nothing at a zero density (possible only at a
 /// light's rim in f32) or a zero radiance.
 #[inline]
-fn weighed(scattering: Vec3, radiance: Vec3, pdf: f64) -> Vec3 {
+pub(super) fn weighed(scattering: Vec3, radiance: Vec3, pdf: f64) -> Vec3 {
     if pdf <= 0.0 || radiance == Vec3::ZERO {
         return Vec3::ZERO;
     }
@@ -535,6 +552,7 @@ mod tests {
                 field: None,
                 clock: None,
                 blockers: &std::cell::Cell::default(),
+                sky_pool: None,
             };
             let lanes = PlainLanes::of(&run).expect("lights the lanes take");
             let numbers = batch.begin_plain(run.rays, run.seed).to_vec();
@@ -582,6 +600,74 @@ mod tests {
             unreachable!("the scene has a map")
         };
         compare_batches(&world, &guides(map.partition(GuideLayout::Octahedral(8))));
+    }
+
+    /// A pixel's gathers with their map lookups pooled ([`gather_samples`]) bring what
+    /// they bring one by one ([`gather`]), up to the rounding of sums made in another
+    /// order; without the pool's lookups they would bring much less.
+    ///
+    /// [`gather_samples`]: super::super::gather_samples
+    /// [`gather`]: super::super::gather
+    #[test]
+    fn a_pixels_pooled_map_lookups_bring_what_its_gathers_bring_one_by_one() {
+        use super::super::settings::Preset;
+        use super::super::{gather, gather_samples, GatherLearning, GatherTile};
+        use crate::render::{PixelRect, Tile};
+        let world = scene_under("sky-pool", &format!("{MAP}{AREA_LIGHTS}"));
+        let settings = GatherSettings::preset(Preset::Off);
+        let tile = Tile {
+            rect: PixelRect::whole(8, 8),
+            image: (8, 8),
+            seed: 1,
+            learns: false,
+        };
+        let learning = GatherLearning::new(&world, &settings);
+        let begin = || {
+            let counts = &mut RayCounts::default();
+            GatherTile::begin(&world, &settings, &tile, &learning, counts, ())
+        };
+        let eye = Vec3::new(2.0, -3.0, 2.5);
+        let mut aim = Pcg32::new(3, 0);
+        let rays: Vec<Ray> = (0..40)
+            .map(|_| {
+                let target = Vec3::new(aim.next_f32() * 3.0 - 1.5, aim.next_f32() * 3.0 - 1.5, 0.0);
+                Ray::new(eye, (target - eye).normalize())
+            })
+            .collect();
+        let counts = &mut RayCounts::default();
+        let (mut one_by_one, mut rng) = (begin(), Pcg32::new(9, 0));
+        let single: Vec<[f32; 3]> = (rays.iter())
+            .map(|ray| gather(&world, &settings, ray, &mut rng, &mut one_by_one, counts).to_array())
+            .collect();
+        let mut pooled = Vec::new();
+        gather_samples(
+            &world,
+            &settings,
+            &rays,
+            &mut Pcg32::new(9, 0),
+            &mut begin(),
+            counts,
+            &mut pooled,
+        );
+        // The same gathers with the pool open and never resolved: what they leave out.
+        let (mut unresolved, mut rng) = (begin(), Pcg32::new(9, 0));
+        unresolved.sky_pool.get_mut().open();
+        let left_out: Vec<[f32; 3]> = (rays.iter())
+            .map(|ray| gather(&world, &settings, ray, &mut rng, &mut unresolved, counts).to_array())
+            .collect();
+        let total = |values: &[[f32; 3]]| values.iter().flatten().map(|&c| c as f64).sum::<f64>();
+        assert!(
+            total(&left_out) < 0.8 * total(&single),
+            "the pool takes a share"
+        );
+        for (sample, (a, b)) in pooled.iter().zip(&single).enumerate() {
+            for (a, b) in a.iter().zip(b) {
+                assert!(
+                    (a - b).abs() <= 1e-5 * b.abs() + 1e-7,
+                    "sample {sample}: {a} vs {b}"
+                );
+            }
+        }
     }
 
     /// Under a constant sky, drawn uniformly and from a guide's uniform texels.
