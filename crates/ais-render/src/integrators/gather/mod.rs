@@ -471,22 +471,29 @@ pub fn gather_samples<P: BatchProbe>(
     counts: &mut RayCounts,
     values: &mut Vec<[f32; 3]>,
 ) {
-    let first = values.len();
     let map = match &world.lights.environment {
         Some(Environment::Map(map)) => Some(map),
         _ => None,
     };
-    if map.is_some() {
-        state.sky_pool.get_mut().open();
-    }
-    for (sample, ray) in rays.iter().enumerate() {
-        state.sky_pool.get_mut().begin_sample(sample as u32);
-        values.push(gather(world, settings, ray, rng, state, counts).to_array());
-    }
-    if let Some(map) = map {
-        state.sky_pool.get_mut().resolve(map, &mut values[first..]);
+    // A pool per group of samples, so that it stays small whatever the samples per pixel.
+    for rays in rays.chunks(POOLED_SAMPLES) {
+        let first = values.len();
+        if map.is_some() {
+            state.sky_pool.get_mut().open();
+        }
+        for (sample, ray) in rays.iter().enumerate() {
+            state.sky_pool.get_mut().begin_sample(sample as u32);
+            values.push(gather(world, settings, ray, rng, state, counts).to_array());
+        }
+        if let Some(map) = map {
+            state.sky_pool.get_mut().resolve(map, &mut values[first..]);
+        }
     }
 }
+
+/// How many of a pixel's samples share a pool of environment-map lookups: about a
+/// thousand lookups at 16 candidates per gather (some 70 KiB), enough to fill the lanes.
+const POOLED_SAMPLES: usize = 64;
 
 /// Whether a gather of `state`'s may leave its environment-map lookups in the pixel's pool:
 /// while the pool is open, unless something reads the gather's candidates one by one (their

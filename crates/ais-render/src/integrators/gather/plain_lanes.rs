@@ -602,9 +602,9 @@ mod tests {
         compare_batches(&world, &guides(map.partition(GuideLayout::Octahedral(8))));
     }
 
-    /// A pixel's gathers with their map lookups pooled ([`gather_samples`]) bring what
-    /// they bring one by one ([`gather`]), up to the rounding of sums made in another
-    /// order; without the pool's lookups they would bring much less.
+    /// A pixel's gathers with their map lookups pooled ([`gather_samples`], 100 samples: two
+    /// pools) bring what they bring one by one ([`gather`]), up to the rounding of sums
+    /// made in another order; without the pool's lookups they would bring much less.
     ///
     /// [`gather_samples`]: super::super::gather_samples
     /// [`gather`]: super::super::gather
@@ -628,7 +628,7 @@ mod tests {
         };
         let eye = Vec3::new(2.0, -3.0, 2.5);
         let mut aim = Pcg32::new(3, 0);
-        let rays: Vec<Ray> = (0..40)
+        let rays: Vec<Ray> = (0..100)
             .map(|_| {
                 let target = Vec3::new(aim.next_f32() * 3.0 - 1.5, aim.next_f32() * 3.0 - 1.5, 0.0);
                 Ray::new(eye, (target - eye).normalize())
