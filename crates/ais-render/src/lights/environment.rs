@@ -65,7 +65,8 @@ pub struct EnvironmentMap {
     partitions: super::environment_guide::PartitionCache,
 }
 
-/// How many cell points [`EnvironmentMap::towards_at`] works out at once.
+/// How many cell points [`EnvironmentMap::towards_at`], or lookups
+/// [`EnvironmentMap::look_up_lanes`], works out at once.
 pub(crate) const LANES: usize = 16;
 
 /// A point of an environment map's cell: its row and column, and the fractions of its
