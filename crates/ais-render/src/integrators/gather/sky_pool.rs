@@ -11,8 +11,9 @@
 //! share is added to its sample's value.
 //!
 //! The value is the same sum, in another order: a sample's value differs from the one-by-one
-//! form by rounding (a few units in the last place). Only AIS off's plain batches with an
-//! unguided map pool: nothing else reads a candidate's value before the pixel is done.
+//! form by rounding (a few units in the last place). Only AIS off's plain batches under an
+//! unguided map pool, and only where nothing reads a candidate's value as it comes (a
+//! gather's spread, a race's moments, a probe).
 
 use super::plain_lanes::weighed;
 use super::strategy::MisParts;
