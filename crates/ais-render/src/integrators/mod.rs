@@ -148,11 +148,7 @@ impl SampleIntegrator for Integrator {
             (Integrator::Gather(settings), IntegratorTile::Gather(state)) => {
                 gather::gather_samples(world, settings, rays, rng, state, counts, values)
             }
-            (_, state) => {
-                for ray in rays {
-                    values.push(self.radiance(world, ray, rng, state, counts));
-                }
-            }
+            (_, state) => self.radiance_of_each(world, rays, rng, state, counts, values),
         }
     }
 }

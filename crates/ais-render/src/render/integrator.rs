@@ -145,6 +145,21 @@ pub trait SampleIntegrator: Sync {
         counts: &mut RayCounts,
         values: &mut Vec<[f32; 3]>,
     ) {
+        self.radiance_of_each(world, rays, rng, state, counts, values);
+    }
+
+    /// [`SampleIntegrator::radiance`] of each of `rays`, in order, pushed onto `values`: what
+    /// [`SampleIntegrator::pixel_radiance`] does by default, and what an integrator's own
+    /// form of it can fall back to (not meant to be overridden).
+    fn radiance_of_each(
+        &self,
+        world: &World,
+        rays: &[Ray],
+        rng: &mut Pcg32,
+        state: &mut Self::Tile,
+        counts: &mut RayCounts,
+        values: &mut Vec<[f32; 3]>,
+    ) {
         for ray in rays {
             values.push(self.radiance(world, ray, rng, state, counts));
         }
