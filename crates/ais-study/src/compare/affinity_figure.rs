@@ -68,7 +68,7 @@ pub fn snapshots(
         field: None,
         clock: None,
         blockers: &std::cell::Cell::default(),
-        sky_pool: None,
+        pixel_pool: None,
     };
     run_batch(
         &run,

@@ -6,10 +6,10 @@ use super::gather_sizes::CandidateSpread;
 use super::guiding::CandidateSampler;
 use super::light::{free_radiance, radiance_if_free, trace_aimed, Leaving, ShadowRay};
 use super::mis_share::ShareMoments;
+use super::pixel_pool::PixelPool;
 use super::plain_lanes::PlainLanes;
 use super::settings::GatherSettings;
 use super::shared_origin::SharedOrigin;
-use super::sky_pool::SkyPool;
 use super::strategy::{CandidateDraw, GatherPoint, MisParts};
 use crate::geometry::RecentBlockers;
 use crate::lights::{luminance, EnvironmentDraws, RectangleDraws, Toward};
@@ -69,8 +69,8 @@ pub struct BatchRun<'a> {
     /// on ([`RecentBlockers::passed_on`]); this batch passes on its own.
     pub blockers: &'a Cell<RecentBlockers>,
     /// Where a plain batch leaves its environment-map lookups for the pixel's gathers to
-    /// make together ([`SkyPool`]); `None`: it makes them itself.
-    pub sky_pool: Option<&'a RefCell<SkyPool>>,
+    /// make together ([`PixelPool`]); `None`: it makes them itself.
+    pub pixel_pool: Option<&'a RefCell<PixelPool>>,
 }
 
 impl BatchRun<'_> {

@@ -626,7 +626,7 @@ pub(super) fn field_gather<P: BatchProbe>(
         field: rolling.map(|cell| FieldUse { cell, cost_ratio }),
         clock: timed.then_some(&clock),
         blockers,
-        sky_pool: None,
+        pixel_pool: None,
     };
     let batch = batch_for(batch, settings);
     let before = *batch.stats();

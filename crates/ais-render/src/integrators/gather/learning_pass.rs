@@ -149,7 +149,7 @@ impl LearningPass {
             field: None,
             clock: None,
             blockers: &self.blockers,
-            sky_pool: None,
+            pixel_pool: None,
         };
         run_batch(&run, batch, counts, &mut (), Lessons::default());
         let observations = batch

@@ -22,11 +22,11 @@ pub mod guiding;
 pub mod learning_pass;
 mod light;
 pub mod mis_share;
+pub mod pixel_pool;
 mod plain_lanes;
 pub mod race;
 pub mod settings;
 mod shared_origin;
-pub mod sky_pool;
 pub mod strategy;
 
 pub use acceptance::Acceptance;
@@ -50,8 +50,8 @@ use glam::Vec3;
 use guiding::{CandidateSampler, Guidance, Guide};
 use learning_pass::LearningPass;
 use mis_share::ShareMoments;
+use pixel_pool::PixelPool;
 use race::{RaceResult, TileMoments};
-use sky_pool::SkyPool;
 use std::cell::{Cell, RefCell};
 use std::sync::Arc;
 
@@ -115,8 +115,8 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) batch: Option<Batch<[f32; 3]>>,
     /// What blocked the shadow rays of the tile's last gather, passed on to the next.
     pub(super) blockers: Cell<RecentBlockers>,
-    /// The environment-map lookups of the pixel's gathers, made together ([`SkyPool`]).
-    pub(super) sky_pool: RefCell<SkyPool>,
+    /// The environment-map lookups of the pixel's gathers, made together ([`PixelPool`]).
+    pub(super) pixel_pool: RefCell<PixelPool>,
     /// The tile's recent gathers, for shared maps in tile order.
     recent: RecentGathers,
     /// The learning pass around this tile, for shared maps from a learning pass.
@@ -204,7 +204,7 @@ impl<P: BatchProbe> GatherTile<P> {
         let mut state = GatherTile {
             batch: None,
             blockers: Cell::default(),
-            sky_pool: RefCell::default(),
+            pixel_pool: RefCell::default(),
             recent: RecentGathers::default(),
             learned: LearningPass::default(),
             guide: None,
@@ -461,7 +461,7 @@ pub fn gather<P: BatchProbe>(
 
 /// The values of a pixel's camera `rays` (its samples, in order), pushed onto `values`:
 /// [`gather`] of each, with the environment-map lookups of AIS off's plain batches pooled
-/// across them and made together ([`SkyPool`]).
+/// across them and made together ([`PixelPool`]).
 pub fn gather_samples<P: BatchProbe>(
     world: &World,
     settings: &GatherSettings,
@@ -472,22 +472,19 @@ pub fn gather_samples<P: BatchProbe>(
     values: &mut Vec<[f32; 3]>,
 ) {
     let map = match &world.lights.environment {
-        Some(Environment::Map(map)) => Some(map),
+        Some(Environment::Map(map)) => Some(&**map),
         _ => None,
     };
     // A pool per group of samples, so that it stays small whatever the samples per pixel.
     for rays in rays.chunks(POOLED_SAMPLES) {
         let first = values.len();
-        if map.is_some() {
-            state.sky_pool.get_mut().open();
-        }
+        state.pixel_pool.get_mut().open();
         for (sample, ray) in rays.iter().enumerate() {
-            state.sky_pool.get_mut().begin_sample(sample as u32);
+            state.pixel_pool.get_mut().begin_sample(sample as u32);
             values.push(gather(world, settings, ray, rng, state, counts).to_array());
         }
-        if let Some(map) = map {
-            state.sky_pool.get_mut().resolve(map, &mut values[first..]);
-        }
+        let pool = state.pixel_pool.get_mut();
+        pool.resolve(&world.geometry, map, &mut values[first..]);
     }
 }
 
@@ -498,8 +495,8 @@ const POOLED_SAMPLES: usize = 64;
 /// Whether a gather of `state`'s may leave its environment-map lookups in the pixel's pool:
 /// while the pool is open, unless something reads the gather's candidates one by one (their
 /// spread, a race's moments, or a probe).
-fn pools_sky<P: BatchProbe>(state: &GatherTile<P>) -> bool {
-    state.sky_pool.borrow().is_open()
+fn pools<P: BatchProbe>(state: &GatherTile<P>) -> bool {
+    state.pixel_pool.borrow().is_open()
         && state.spread.is_none()
         && state.race.is_none()
         && !P::WATCHES
@@ -539,7 +536,7 @@ fn map_gather<P: BatchProbe>(
     // A guided gather points `at` at a guide borrowed from `state`: a shorter lifetime.
     let mut at: GatherPoint<'_> = at;
     let sharing = settings.shares_maps();
-    let pools_sky = pools_sky(state);
+    let pools = pools(state);
     let batch = batch_for(&mut state.batch, settings);
     let mut sampler = CandidateSampler::plain(settings.strategy);
     let start = if sharing {
@@ -572,7 +569,7 @@ fn map_gather<P: BatchProbe>(
         field: None,
         clock: None,
         blockers: &state.blockers,
-        sky_pool: pools_sky.then_some(&state.sky_pool),
+        pixel_pool: pools.then_some(&state.pixel_pool),
     };
     let lessons = Lessons {
         spread: state.spread.as_mut(),

@@ -9,10 +9,11 @@
 
 use super::batch_loop::{BatchRun, PlainSum};
 use super::light::shadow_ray;
+use super::pixel_pool::{Brings, SkyLookup};
 use super::shared_origin::SharedOrigin;
-use super::sky_pool::SkyLookup;
 use super::strategy::{MisParts, MisPick, Strategy};
 use crate::bsdf::{diffuse_direction, DiffuseHit, SpecularMass};
+use crate::geometry::Ray;
 use crate::lights::{
     Aim, Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap, MapLocation,
     MapWeights, Receiver, RectangleDraws, Source, Toward, LANES,
@@ -123,6 +124,9 @@ struct Lanes {
     free: [bool; RUN],
     /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
     specular: [Option<SpecularMass>; RUN],
+    /// Its shadow ray, where it is left to the pixel's pool to trace (then `free` holds
+    /// until the pool finds otherwise).
+    deferred: [Option<Ray>; RUN],
 }
 
 impl Default for Lanes {
@@ -137,6 +141,7 @@ impl Default for Lanes {
             drawn: [false; RUN],
             free: [false; RUN],
             specular: [None; RUN],
+            deferred: [None; RUN],
         }
     }
 }
@@ -220,15 +225,24 @@ impl<'a> PlainLanes<'a> {
             if SOURCES {
                 meet(run, &mut lanes, count);
             }
-            trace::<SOURCES>(run, &mut lanes, count, counts, &mut origin);
+            let rays = Rays {
+                counts: &mut *counts,
+                origin: &mut origin,
+                deferring: run.pixel_pool.is_some(),
+            };
+            rays.trace::<SOURCES>(run, &mut lanes, count);
             // All the lookups after all the rays, so that they overlap. A candidate whose
             // ray was blocked or not needed adds its zero, as in the general runs (the
-            // gather's spread counts it).
+            // gather's spread counts it), and so does one left to the pixel's pool.
             for k in (0..count).filter(|&k| lanes.kept[k]) {
-                total.add(if lanes.free[k] {
-                    self.brought::<SOURCES>(run, &lanes, k)
-                } else {
-                    Vec3::ZERO
+                total.add(match (lanes.free[k], lanes.deferred[k], run.pixel_pool) {
+                    (false, ..) => Vec3::ZERO,
+                    (true, Some(ray), Some(pool)) => {
+                        let brings = self.brings::<SOURCES>(run, &lanes, k);
+                        pool.borrow_mut().leave(ray, brings, 1.0 / run.rays as f32);
+                        Vec3::ZERO
+                    }
+                    (true, ..) => self.brought::<SOURCES>(run, &lanes, k),
                 });
             }
         }
@@ -300,22 +314,6 @@ impl<'a> PlainLanes<'a> {
             true => &lanes.source[k],
             false => &Source::Environment,
         };
-        if let (Source::Environment, Some(pool)) = (source, run.sky_pool) {
-            if let (Some(Sky::Map { guide: None, .. }), None) = (&self.sky, lanes.specular[k]) {
-                let (scattering, bsdf_density) = self.bsdf_value_and_density(run, direction);
-                pool.borrow_mut().leave(SkyLookup {
-                    direction,
-                    location: lanes.location[k],
-                    scattering,
-                    bsdf_density,
-                    choice: self.choice,
-                    share: self.share,
-                    weight: (1.0 / run.rays as f64) as f32,
-                });
-                // Its value is added to the sample's once the pixel's lookups are made.
-                return Vec3::ZERO;
-            }
-        }
         let (radiance, light_density) = match (source, &self.sky) {
             (Source::Area(point), _) => (point.radiance, point.density),
             (Source::Environment, Some(sky)) => {
@@ -341,6 +339,27 @@ impl<'a> PlainLanes<'a> {
             }
         };
         weighed(scattering, radiance, pdf)
+    }
+
+    /// What candidate `k` of `lanes`, whose ray is left to the pixel's pool, brings if the
+    /// ray is free: the numbers of a lookup on an unguided map, which the pool makes with
+    /// others in lanes, or else its value ([`PlainLanes::brought`]).
+    fn brings<const SOURCES: bool>(&self, run: &BatchRun, lanes: &Lanes, k: usize) -> Brings {
+        let to_sky = !SOURCES || matches!(lanes.source[k], Source::Environment);
+        let unguided_map = matches!(self.sky, Some(Sky::Map { guide: None, .. }));
+        if !(to_sky && unguided_map && lanes.specular[k].is_none()) {
+            return Brings::Value(self.brought::<SOURCES>(run, lanes, k));
+        }
+        let direction = lanes.direction[k];
+        let (scattering, bsdf_density) = self.bsdf_value_and_density(run, direction);
+        Brings::Sky(SkyLookup {
+            direction,
+            location: lanes.location[k],
+            scattering,
+            bsdf_density,
+            choice: self.choice,
+            share: self.share,
+        })
     }
 
     /// Whether light along `direction` reaches the viewer through the BSDF's continuous
@@ -403,43 +422,57 @@ fn meet(run: &BatchRun, lanes: &mut Lanes, count: usize) {
     });
 }
 
-/// Traces the shadow rays of the kept candidates of `lanes` (the first `count`) that could
-/// bring light, toward the point of the area light they meet or the environment, with what
-/// the gather's earlier rays learned (`origin`), and notes which are free. Without area
-/// lights besides the environment (`SOURCES`), every one meets it and no shaft bounds any.
-fn trace<const SOURCES: bool>(
-    run: &BatchRun,
-    lanes: &mut Lanes,
-    count: usize,
-    counts: &mut RayCounts,
-    origin: &mut SharedOrigin,
-) {
-    let (world, at) = (run.world, run.at);
-    let lights = &world.lights;
-    let shaft_light = |source: &Source| match SOURCES {
-        true => lights.shaft_light_of(source),
-        false => None,
-    };
-    if SOURCES {
-        let aimed = (0..count).filter(|&k| lanes.kept[k]);
-        origin.expect(aimed.map(|k| shaft_light(&lanes.source[k])));
-    }
-    for k in 0..count {
-        let aim = match SOURCES {
-            _ if !lanes.kept[k] => Aim::Nothing,
-            true => lights.aim_at(&at.receiver, &lanes.source[k]),
-            false => Aim::Unbounded,
+/// Where a run's shadow rays go: traced at once, with what the gather's earlier rays
+/// learned (`origin`), or left to the pixel's pool (`deferring`).
+struct Rays<'r> {
+    counts: &'r mut RayCounts,
+    origin: &'r mut SharedOrigin,
+    deferring: bool,
+}
+
+impl Rays<'_> {
+    /// Traces (or leaves to the pool) the shadow rays of the kept candidates of `lanes`
+    /// (the first `count`) that could bring light, toward the point of the area light they
+    /// meet or the environment, and notes which are free. Without area lights besides the
+    /// environment (`SOURCES`), every one meets it and no shaft bounds any.
+    fn trace<const SOURCES: bool>(self, run: &BatchRun, lanes: &mut Lanes, count: usize) {
+        let (world, at) = (run.world, run.at);
+        let lights = &world.lights;
+        let shaft_light = |source: &Source| match SOURCES {
+            true => lights.shaft_light_of(source),
+            false => None,
         };
-        let target = match aim {
-            Aim::Nothing => None,
-            Aim::Point(target) => Some(Some(target)),
-            Aim::Unbounded => Some(None),
-        };
-        lanes.free[k] = target.is_some_and(|target| {
-            counts.occlusion += 1;
-            let ray = shadow_ray(at, lanes.direction[k], target);
-            !origin.occluded_aiming(world, at, shaft_light(&lanes.source[k]), &ray)
-        });
+        if SOURCES {
+            let aimed = (0..count).filter(|&k| lanes.kept[k]);
+            self.origin
+                .expect(aimed.map(|k| shaft_light(&lanes.source[k])));
+        }
+        for k in 0..count {
+            lanes.deferred[k] = None;
+            let aim = match SOURCES {
+                _ if !lanes.kept[k] => Aim::Nothing,
+                true => lights.aim_at(&at.receiver, &lanes.source[k]),
+                false => Aim::Unbounded,
+            };
+            let target = match aim {
+                Aim::Nothing => None,
+                Aim::Point(target) => Some(Some(target)),
+                Aim::Unbounded => Some(None),
+            };
+            lanes.free[k] = target.is_some_and(|target| {
+                self.counts.occlusion += 1;
+                let ray = shadow_ray(at, lanes.direction[k], target);
+                // A ray toward a light with a shaft is left to the gather, which may find
+                // it free from the shaft (measured: deferring those lost time in a room lit
+                // through a door gap).
+                let light = shaft_light(&lanes.source[k]);
+                if self.deferring && light.is_none() {
+                    lanes.deferred[k] = Some(ray);
+                    return true;
+                }
+                !self.origin.occluded_aiming(world, at, light, &ray)
+            });
+        }
     }
 }
 
@@ -552,7 +585,7 @@ mod tests {
                 field: None,
                 clock: None,
                 blockers: &std::cell::Cell::default(),
-                sky_pool: None,
+                pixel_pool: None,
             };
             let lanes = PlainLanes::of(&run).expect("lights the lanes take");
             let numbers = batch.begin_plain(run.rays, run.seed).to_vec();
@@ -609,11 +642,26 @@ mod tests {
     /// [`gather_samples`]: super::super::gather_samples
     /// [`gather`]: super::super::gather
     #[test]
-    fn a_pixels_pooled_map_lookups_bring_what_its_gathers_bring_one_by_one() {
+    fn a_pixels_pooled_rays_and_map_lookups_bring_what_its_gathers_bring_one_by_one() {
+        let world = scene_under("pixel-pool-map", &format!("{MAP}{AREA_LIGHTS}"));
+        pooled_gathers_bring_what_they_bring_one_by_one(&world);
+    }
+
+    /// With no map: only the pool's rays.
+    #[test]
+    fn a_pixels_pooled_rays_under_a_constant_sky_bring_what_its_gathers_bring_one_by_one() {
+        let constant =
+            r#"<emitter type="constant"><rgb name="radiance" value="3, 3.5, 4"/></emitter>"#;
+        let world = scene_under("pixel-pool-constant", &format!("{constant}{AREA_LIGHTS}"));
+        pooled_gathers_bring_what_they_bring_one_by_one(&world);
+    }
+
+    /// A pixel's 100 gathers (two pools) in `world` bring, with the pool, what they bring
+    /// one by one without it, and the pool takes a real share of it.
+    fn pooled_gathers_bring_what_they_bring_one_by_one(world: &World) {
         use super::super::settings::Preset;
         use super::super::{gather, gather_samples, GatherLearning, GatherTile};
         use crate::render::{PixelRect, Tile};
-        let world = scene_under("sky-pool", &format!("{MAP}{AREA_LIGHTS}"));
         let settings = GatherSettings::preset(Preset::Off);
         let tile = Tile {
             rect: PixelRect::whole(8, 8),
@@ -621,10 +669,10 @@ mod tests {
             seed: 1,
             learns: false,
         };
-        let learning = GatherLearning::new(&world, &settings);
+        let learning = GatherLearning::new(world, &settings);
         let begin = || {
             let counts = &mut RayCounts::default();
-            GatherTile::begin(&world, &settings, &tile, &learning, counts, ())
+            GatherTile::begin(world, &settings, &tile, &learning, counts, ())
         };
         let eye = Vec3::new(2.0, -3.0, 2.5);
         let mut aim = Pcg32::new(3, 0);
@@ -637,11 +685,11 @@ mod tests {
         let counts = &mut RayCounts::default();
         let (mut one_by_one, mut rng) = (begin(), Pcg32::new(9, 0));
         let single: Vec<[f32; 3]> = (rays.iter())
-            .map(|ray| gather(&world, &settings, ray, &mut rng, &mut one_by_one, counts).to_array())
+            .map(|ray| gather(world, &settings, ray, &mut rng, &mut one_by_one, counts).to_array())
             .collect();
         let mut pooled = Vec::new();
         gather_samples(
-            &world,
+            world,
             &settings,
             &rays,
             &mut Pcg32::new(9, 0),
@@ -651,14 +699,16 @@ mod tests {
         );
         // The same gathers with the pool open and never resolved: what they leave out.
         let (mut unresolved, mut rng) = (begin(), Pcg32::new(9, 0));
-        unresolved.sky_pool.get_mut().open();
+        unresolved.pixel_pool.get_mut().open();
         let left_out: Vec<[f32; 3]> = (rays.iter())
-            .map(|ray| gather(&world, &settings, ray, &mut rng, &mut unresolved, counts).to_array())
+            .map(|ray| gather(world, &settings, ray, &mut rng, &mut unresolved, counts).to_array())
             .collect();
         let total = |values: &[[f32; 3]]| values.iter().flatten().map(|&c| c as f64).sum::<f64>();
         assert!(
             total(&left_out) < 0.8 * total(&single),
-            "the pool takes a share"
+            "the pool takes a share: {} of {}",
+            total(&left_out),
+            total(&single)
         );
         for (sample, (a, b)) in pooled.iter().zip(&single).enumerate() {
             for (a, b) in a.iter().zip(b) {
