@@ -543,6 +543,15 @@ impl Lights {
         self.shaft_light_of(&toward.source)
     }
 
+    /// Whether some shadow rays toward the lights are bounded by no shaft
+    /// ([`Lights::shaft_light_of`]): rays toward an environment, a delta light, or an
+    /// area light no shaft bounds.
+    pub(crate) fn some_rays_unbounded(&self) -> bool {
+        self.environment.is_some()
+            || !self.delta.is_empty()
+            || self.bounded_by_shafts.iter().any(|&bounded| !bounded)
+    }
+
     /// The area light whose point `source` is, where a shaft bounds its rays
     /// ([`Lights::aimed_shaft_light`]).
     #[inline]

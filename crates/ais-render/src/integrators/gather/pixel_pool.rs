@@ -116,6 +116,9 @@ impl PixelPool {
         values: &mut [[f32; 3]],
     ) {
         self.open = false;
+        if self.left.is_empty() {
+            return;
+        }
         self.trace(geometry);
         let mut run = [0; MAP_LANES];
         let mut in_run = 0;
@@ -186,6 +189,7 @@ fn add(value: &mut [f32; 3], brought: Vec3, weight: f32) {
 
 /// Looks up what the candidates `run` of `left` (at most sixteen, each meeting `map`)
 /// bring, all at once, and adds each to its sample's value in `values`.
+#[inline(always)]
 fn look_up(map: &EnvironmentMap, left: &[Left], run: &[usize], values: &mut [[f32; 3]]) {
     let lookup = |i: usize| match left[i].brings {
         Brings::Sky(lookup) => lookup,

@@ -13,7 +13,6 @@ use super::pixel_pool::{Brings, SkyLookup};
 use super::shared_origin::SharedOrigin;
 use super::strategy::{MisParts, MisPick, Strategy};
 use crate::bsdf::{diffuse_direction, DiffuseHit, SpecularMass};
-use crate::geometry::Ray;
 use crate::lights::{
     Aim, Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap, MapLocation,
     MapWeights, Receiver, RectangleDraws, Source, Toward, LANES,
@@ -40,6 +39,8 @@ pub(super) struct PlainLanes<'a> {
     /// A single diffuse material, whose draws and numbers are worked out here (other BSDFs
     /// are asked for theirs).
     diffuse: Option<DiffuseHit>,
+    /// Whether the shadow rays that no shaft bounds are left to the pixel's pool.
+    defers: bool,
 }
 
 /// The environment, as the lanes look it up.
@@ -124,9 +125,10 @@ struct Lanes {
     free: [bool; RUN],
     /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
     specular: [Option<SpecularMass>; RUN],
-    /// Its shadow ray, where it is left to the pixel's pool to trace (then `free` holds
-    /// until the pool finds otherwise).
-    deferred: [Option<Ray>; RUN],
+    /// Whether its shadow ray is left to the pixel's pool to trace (then `free` holds until
+    /// the pool finds otherwise), and the point the ray ends at, if it ends.
+    deferred: [bool; RUN],
+    target: [Option<Vec3>; RUN],
 }
 
 impl Default for Lanes {
@@ -141,7 +143,8 @@ impl Default for Lanes {
             drawn: [false; RUN],
             free: [false; RUN],
             specular: [None; RUN],
-            deferred: [None; RUN],
+            deferred: [false; RUN],
+            target: [None; RUN],
         }
     }
 }
@@ -187,6 +190,7 @@ impl<'a> PlainLanes<'a> {
             share: at.mis_bsdf_share,
             choice,
             sources: !(lights.area.is_empty() && lights.delta.is_empty()),
+            defers: run.pixel_pool.is_some() && lights.some_rays_unbounded(),
         })
     }
 
@@ -201,14 +205,21 @@ impl<'a> PlainLanes<'a> {
     ) {
         // Compiled twice: lit by the environment alone, the lanes keep no sources (keeping
         // them cost scenes lit by a sky about 2% of a frame).
-        match self.sources {
-            true => self.run_lanes::<true>(run, numbers, counts, total),
-            false => self.run_lanes::<false>(run, numbers, counts, total),
+        // And twice again: where no ray is left to the pixel's pool, the lanes are those
+        // of the one-by-one form (the form with the pool cost scenes lit by sphere
+        // lights alone some 4%).
+        match (self.sources, self.defers) {
+            (true, true) => self.run_lanes::<true, true>(run, numbers, counts, total),
+            (true, false) => self.run_lanes::<true, false>(run, numbers, counts, total),
+            (false, true) => self.run_lanes::<false, true>(run, numbers, counts, total),
+            (false, false) => self.run_lanes::<false, false>(run, numbers, counts, total),
         }
     }
 
-    /// [`PlainLanes::run`], with lights besides the environment (`SOURCES`) or none.
-    fn run_lanes<const SOURCES: bool>(
+    /// [`PlainLanes::run`], with lights besides the environment (`SOURCES`) or none, and
+    /// with the rays that no shaft bounds left to the pixel's pool (`DEFERS`) or not.
+    #[inline(never)]
+    fn run_lanes<const SOURCES: bool, const DEFERS: bool>(
         &self,
         run: &BatchRun,
         numbers: &[[f32; 2]],
@@ -228,22 +239,24 @@ impl<'a> PlainLanes<'a> {
             let rays = Rays {
                 counts: &mut *counts,
                 origin: &mut origin,
-                deferring: run.pixel_pool.is_some(),
             };
-            rays.trace::<SOURCES>(run, &mut lanes, count);
+            rays.trace::<SOURCES, DEFERS>(run, &mut lanes, count);
             // All the lookups after all the rays, so that they overlap. A candidate whose
             // ray was blocked or not needed adds its zero, as in the general runs (the
             // gather's spread counts it), and so does one left to the pixel's pool.
             for k in (0..count).filter(|&k| lanes.kept[k]) {
-                total.add(match (lanes.free[k], lanes.deferred[k], run.pixel_pool) {
-                    (false, ..) => Vec3::ZERO,
-                    (true, Some(ray), Some(pool)) => {
-                        let brings = self.brings::<SOURCES>(run, &lanes, k);
-                        pool.borrow_mut().leave(ray, brings, 1.0 / run.rays as f32);
-                        Vec3::ZERO
-                    }
-                    (true, ..) => self.brought::<SOURCES>(run, &lanes, k),
-                });
+                total.add(
+                    match (lanes.free[k], DEFERS && lanes.deferred[k], run.pixel_pool) {
+                        (false, ..) => Vec3::ZERO,
+                        (true, true, Some(pool)) => {
+                            let ray = shadow_ray(run.at, lanes.direction[k], lanes.target[k]);
+                            let brings = self.brings::<SOURCES>(run, &lanes, k);
+                            pool.borrow_mut().leave(ray, brings, 1.0 / run.rays as f32);
+                            Vec3::ZERO
+                        }
+                        (true, ..) => self.brought::<SOURCES>(run, &lanes, k),
+                    },
+                );
             }
         }
         run.pass_on(&origin);
@@ -256,6 +269,7 @@ impl<'a> PlainLanes<'a> {
     ///
     /// [`GatherPoint::draw_bsdf_run`]: super::strategy::GatherPoint::draw_bsdf_run
     /// [`GatherPoint::carries`]: super::strategy::GatherPoint::carries
+    #[inline(always)]
     fn draw<const SOURCES: bool>(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
         let at = run.at;
         let mut environment = EnvironmentDraws::default();
@@ -344,6 +358,7 @@ impl<'a> PlainLanes<'a> {
     /// What candidate `k` of `lanes`, whose ray is left to the pixel's pool, brings if the
     /// ray is free: the numbers of a lookup on an unguided map, which the pool makes with
     /// others in lanes, or else its value ([`PlainLanes::brought`]).
+    #[inline(always)]
     fn brings<const SOURCES: bool>(&self, run: &BatchRun, lanes: &Lanes, k: usize) -> Brings {
         let to_sky = !SOURCES || matches!(lanes.source[k], Source::Environment);
         let unguided_map = matches!(self.sky, Some(Sky::Map { guide: None, .. }));
@@ -383,7 +398,7 @@ impl<'a> PlainLanes<'a> {
     }
 
     /// [`PlainLanes::bsdf_value`] and the density of the BSDF's draws toward `direction`.
-    #[inline]
+    #[inline(always)]
     fn bsdf_value_and_density(&self, run: &BatchRun, direction: Vec3) -> (Vec3, f64) {
         match &self.diffuse {
             Some(diffuse) => diffuse.eval_and_pdf(direction),
@@ -411,6 +426,7 @@ pub(super) fn weighed(scattering: Vec3, radiance: Vec3, pdf: f64) -> Vec3 {
 
 /// Finds what the kept candidates of `lanes` (the first `count`) whose sources are not
 /// known meet first among the emitters: the BSDF's draws.
+#[inline(always)]
 fn meet(run: &BatchRun, lanes: &mut Lanes, count: usize) {
     let wanted: [bool; RUN] = std::array::from_fn(|k| {
         k < count && lanes.kept[k] && matches!(lanes.source[k], Source::Unknown)
@@ -423,19 +439,25 @@ fn meet(run: &BatchRun, lanes: &mut Lanes, count: usize) {
 }
 
 /// Where a run's shadow rays go: traced at once, with what the gather's earlier rays
-/// learned (`origin`), or left to the pixel's pool (`deferring`).
+/// learned (`origin`), or left to the pixel's pool; counted in `counts` either way.
 struct Rays<'r> {
     counts: &'r mut RayCounts,
     origin: &'r mut SharedOrigin,
-    deferring: bool,
 }
 
 impl Rays<'_> {
     /// Traces (or leaves to the pool) the shadow rays of the kept candidates of `lanes`
     /// (the first `count`) that could bring light, toward the point of the area light they
     /// meet or the environment, and notes which are free. Without area lights besides the
-    /// environment (`SOURCES`), every one meets it and no shaft bounds any.
-    fn trace<const SOURCES: bool>(self, run: &BatchRun, lanes: &mut Lanes, count: usize) {
+    /// environment (`SOURCES`), every one meets it and no shaft bounds any. With `DEFERS`,
+    /// the rays that no shaft bounds are left to the pixel's pool, and noted free until the
+    /// pool finds otherwise.
+    fn trace<const SOURCES: bool, const DEFERS: bool>(
+        self,
+        run: &BatchRun,
+        lanes: &mut Lanes,
+        count: usize,
+    ) {
         let (world, at) = (run.world, run.at);
         let lights = &world.lights;
         let shaft_light = |source: &Source| match SOURCES {
@@ -448,7 +470,6 @@ impl Rays<'_> {
                 .expect(aimed.map(|k| shaft_light(&lanes.source[k])));
         }
         for k in 0..count {
-            lanes.deferred[k] = None;
             let aim = match SOURCES {
                 _ if !lanes.kept[k] => Aim::Nothing,
                 true => lights.aim_at(&at.receiver, &lanes.source[k]),
@@ -461,15 +482,17 @@ impl Rays<'_> {
             };
             lanes.free[k] = target.is_some_and(|target| {
                 self.counts.occlusion += 1;
-                let ray = shadow_ray(at, lanes.direction[k], target);
                 // A ray toward a light with a shaft is left to the gather, which may find
                 // it free from the shaft (measured: deferring those lost time in a room lit
                 // through a door gap).
                 let light = shaft_light(&lanes.source[k]);
-                if self.deferring && light.is_none() {
-                    lanes.deferred[k] = Some(ray);
+                if DEFERS && light.is_none() {
+                    (lanes.deferred[k], lanes.target[k]) = (true, target);
                     return true;
+                } else if DEFERS {
+                    lanes.deferred[k] = false;
                 }
+                let ray = shadow_ray(at, lanes.direction[k], target);
                 !self.origin.occluded_aiming(world, at, light, &ray)
             });
         }
