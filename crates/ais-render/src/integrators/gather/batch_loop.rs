@@ -68,8 +68,8 @@ pub struct BatchRun<'a> {
     /// What blocked the shadow rays of the tile's gather before this one, which it passed
     /// on ([`RecentBlockers::passed_on`]); this batch passes on its own.
     pub blockers: &'a Cell<RecentBlockers>,
-    /// Where a plain batch leaves its environment-map lookups for the pixel's gathers to
-    /// make together ([`PixelPool`]); `None`: it makes them itself.
+    /// Where a plain batch leaves its shadow rays and environment-map lookups for the
+    /// pixel's gathers to make together ([`PixelPool`]); `None`: it makes them itself.
     pub pixel_pool: Option<&'a RefCell<PixelPool>>,
 }
 

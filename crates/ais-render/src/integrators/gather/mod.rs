@@ -115,7 +115,8 @@ pub struct GatherTile<P: BatchProbe = ()> {
     pub(super) batch: Option<Batch<[f32; 3]>>,
     /// What blocked the shadow rays of the tile's last gather, passed on to the next.
     pub(super) blockers: Cell<RecentBlockers>,
-    /// The environment-map lookups of the pixel's gathers, made together ([`PixelPool`]).
+    /// What the pixel's gathers leave to be done together: shadow rays and map lookups
+    /// ([`PixelPool`]).
     pub(super) pixel_pool: RefCell<PixelPool>,
     /// The tile's recent gathers, for shared maps in tile order.
     recent: RecentGathers,
@@ -460,8 +461,8 @@ pub fn gather<P: BatchProbe>(
 }
 
 /// The values of a pixel's camera `rays` (its samples, in order), pushed onto `values`:
-/// [`gather`] of each, with the environment-map lookups of AIS off's plain batches pooled
-/// across them and made together ([`PixelPool`]).
+/// [`gather`] of each, with the shadow rays and environment-map lookups of AIS off's plain
+/// batches pooled across them and made together ([`PixelPool`]).
 pub fn gather_samples<P: BatchProbe>(
     world: &World,
     settings: &GatherSettings,
@@ -488,11 +489,11 @@ pub fn gather_samples<P: BatchProbe>(
     }
 }
 
-/// How many of a pixel's samples share a pool of environment-map lookups: about a
-/// thousand lookups at 16 candidates per gather (some 70 KiB), enough to fill the lanes.
+/// How many of a pixel's samples share a pool: about a thousand candidates at 16 per
+/// gather (some 120 KiB), enough to sort by direction and to fill the lookups' lanes.
 const POOLED_SAMPLES: usize = 64;
 
-/// Whether a gather of `state`'s may leave its environment-map lookups in the pixel's pool:
+/// Whether a gather of `state`'s may leave its shadow rays and map lookups in the pixel's pool:
 /// while the pool is open, unless something reads the gather's candidates one by one (their
 /// spread, a race's moments, or a probe).
 fn pools<P: BatchProbe>(state: &GatherTile<P>) -> bool {

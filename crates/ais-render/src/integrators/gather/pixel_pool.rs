@@ -16,7 +16,7 @@
 //! by rounding (a few units in the last place). Only AIS off's plain batches pool, and
 //! only where nothing reads a candidate's value as it comes (a gather's spread, a race's
 //! moments, a probe). Rays toward a rectangle or a sphere light stay with their gather,
-//! whose shafts ([`super::shared_origin`]) may find them free without tracing.
+//! whose shafts (`SharedOrigin`) may find them free without tracing.
 
 use super::plain_lanes::weighed;
 use super::strategy::MisParts;

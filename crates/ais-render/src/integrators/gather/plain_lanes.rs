@@ -205,9 +205,8 @@ impl<'a> PlainLanes<'a> {
     ) {
         // Compiled twice: lit by the environment alone, the lanes keep no sources (keeping
         // them cost scenes lit by a sky about 2% of a frame).
-        // And twice again: where no ray is left to the pixel's pool, the lanes are those
-        // of the one-by-one form (the form with the pool cost scenes lit by sphere
-        // lights alone some 4%).
+        // And twice again: where no ray is left to the pixel's pool (lights all bounded by
+        // shafts), the lanes are compiled without the pool's steps.
         match (self.sources, self.defers) {
             (true, true) => self.run_lanes::<true, true>(run, numbers, counts, total),
             (true, false) => self.run_lanes::<true, false>(run, numbers, counts, total),
@@ -236,11 +235,7 @@ impl<'a> PlainLanes<'a> {
             if SOURCES {
                 meet(run, &mut lanes, count);
             }
-            let rays = Rays {
-                counts: &mut *counts,
-                origin: &mut origin,
-            };
-            rays.trace::<SOURCES, DEFERS>(run, &mut lanes, count);
+            trace::<SOURCES, DEFERS>(run, &mut lanes, count, counts, &mut origin);
             // All the lookups after all the rays, so that they overlap. A candidate whose
             // ray was blocked or not needed adds its zero, as in the general runs (the
             // gather's spread counts it), and so does one left to the pixel's pool.
@@ -438,64 +433,56 @@ fn meet(run: &BatchRun, lanes: &mut Lanes, count: usize) {
     });
 }
 
-/// Where a run's shadow rays go: traced at once, with what the gather's earlier rays
-/// learned (`origin`), or left to the pixel's pool; counted in `counts` either way.
-struct Rays<'r> {
-    counts: &'r mut RayCounts,
-    origin: &'r mut SharedOrigin,
-}
-
-impl Rays<'_> {
-    /// Traces (or leaves to the pool) the shadow rays of the kept candidates of `lanes`
-    /// (the first `count`) that could bring light, toward the point of the area light they
-    /// meet or the environment, and notes which are free. Without area lights besides the
-    /// environment (`SOURCES`), every one meets it and no shaft bounds any. With `DEFERS`,
-    /// the rays that no shaft bounds are left to the pixel's pool, and noted free until the
-    /// pool finds otherwise.
-    fn trace<const SOURCES: bool, const DEFERS: bool>(
-        self,
-        run: &BatchRun,
-        lanes: &mut Lanes,
-        count: usize,
-    ) {
-        let (world, at) = (run.world, run.at);
-        let lights = &world.lights;
-        let shaft_light = |source: &Source| match SOURCES {
-            true => lights.shaft_light_of(source),
-            false => None,
+/// Traces the shadow rays of the kept candidates of `lanes` (the first `count`) that could
+/// bring light, toward the point of the area light they meet or the environment, with what
+/// the gather's earlier rays learned (`origin`), and notes which are free. Without area
+/// lights besides the environment (`SOURCES`), every one meets it and no shaft bounds any.
+/// With `DEFERS`, the rays that no shaft bounds are left to the pixel's pool instead, and
+/// noted free until the pool finds otherwise.
+fn trace<const SOURCES: bool, const DEFERS: bool>(
+    run: &BatchRun,
+    lanes: &mut Lanes,
+    count: usize,
+    counts: &mut RayCounts,
+    origin: &mut SharedOrigin,
+) {
+    let (world, at) = (run.world, run.at);
+    let lights = &world.lights;
+    let shaft_light = |source: &Source| match SOURCES {
+        true => lights.shaft_light_of(source),
+        false => None,
+    };
+    if SOURCES {
+        let aimed = (0..count).filter(|&k| lanes.kept[k]);
+        origin.expect(aimed.map(|k| shaft_light(&lanes.source[k])));
+    }
+    for k in 0..count {
+        let aim = match SOURCES {
+            _ if !lanes.kept[k] => Aim::Nothing,
+            true => lights.aim_at(&at.receiver, &lanes.source[k]),
+            false => Aim::Unbounded,
         };
-        if SOURCES {
-            let aimed = (0..count).filter(|&k| lanes.kept[k]);
-            self.origin
-                .expect(aimed.map(|k| shaft_light(&lanes.source[k])));
-        }
-        for k in 0..count {
-            let aim = match SOURCES {
-                _ if !lanes.kept[k] => Aim::Nothing,
-                true => lights.aim_at(&at.receiver, &lanes.source[k]),
-                false => Aim::Unbounded,
-            };
-            let target = match aim {
-                Aim::Nothing => None,
-                Aim::Point(target) => Some(Some(target)),
-                Aim::Unbounded => Some(None),
-            };
-            lanes.free[k] = target.is_some_and(|target| {
-                self.counts.occlusion += 1;
-                // A ray toward a light with a shaft is left to the gather, which may find
-                // it free from the shaft (measured: deferring those lost time in a room lit
-                // through a door gap).
-                let light = shaft_light(&lanes.source[k]);
-                if DEFERS && light.is_none() {
-                    (lanes.deferred[k], lanes.target[k]) = (true, target);
+        let target = match aim {
+            Aim::Nothing => None,
+            Aim::Point(target) => Some(Some(target)),
+            Aim::Unbounded => Some(None),
+        };
+        lanes.free[k] = target.is_some_and(|target| {
+            counts.occlusion += 1;
+            // A ray toward a light with a shaft stays with the gather, which may find it
+            // free from the shaft (leaving those to the pool too lost time in a room lit
+            // through a door gap).
+            let light = shaft_light(&lanes.source[k]);
+            if DEFERS {
+                lanes.deferred[k] = light.is_none();
+                lanes.target[k] = target;
+                if light.is_none() {
                     return true;
-                } else if DEFERS {
-                    lanes.deferred[k] = false;
                 }
-                let ray = shadow_ray(at, lanes.direction[k], target);
-                !self.origin.occluded_aiming(world, at, light, &ray)
-            });
-        }
+            }
+            let ray = shadow_ray(at, lanes.direction[k], target);
+            !origin.occluded_aiming(world, at, light, &ray)
+        });
     }
 }
 
@@ -658,9 +645,9 @@ mod tests {
         compare_batches(&world, &guides(map.partition(GuideLayout::Octahedral(8))));
     }
 
-    /// A pixel's gathers with their map lookups pooled ([`gather_samples`], 100 samples: two
-    /// pools) bring what they bring one by one ([`gather`]), up to the rounding of sums
-    /// made in another order; without the pool's lookups they would bring much less.
+    /// A pixel's gathers with their shadow rays and map lookups pooled ([`gather_samples`],
+    /// 100 samples: two pools) bring what they bring one by one ([`gather`]), up to the
+    /// rounding of sums made in another order; without the pool they would bring much less.
     ///
     /// [`gather_samples`]: super::super::gather_samples
     /// [`gather`]: super::super::gather
