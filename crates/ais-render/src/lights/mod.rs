@@ -61,6 +61,8 @@ pub struct Lights {
     only_rectangles: bool,
     /// Per area light, whether a shaft can bound its rays ([`Lights::shaft_toward`]).
     bounded_by_shafts: Vec<bool>,
+    /// Whether some shadow rays are bounded by no shaft ([`Lights::some_rays_unbounded`]).
+    some_unbounded: bool,
 }
 
 /// Where a field cell counts each light's rays: one source per light, or, for the lights
@@ -163,9 +165,14 @@ impl Lights {
         let choice = (!weights.is_empty()).then(|| AliasTable::new(&weights));
         let mut regions: Vec<bool> = area.iter().map(AreaLight::has_regions).collect();
         regions.resize(weights.len(), false);
+        let bounded_by_shafts: Vec<bool> =
+            area.iter().map(|l| shaft_outline(l).is_some()).collect();
         Lights {
             only_rectangles: !area.is_empty() && area.iter().all(|l| l.rectangle().is_some()),
-            bounded_by_shafts: area.iter().map(|l| shaft_outline(l).is_some()).collect(),
+            some_unbounded: environment.is_some()
+                || !delta.is_empty()
+                || bounded_by_shafts.iter().any(|&bounded| !bounded),
+            bounded_by_shafts,
             environment,
             area,
             delta,
@@ -546,10 +553,9 @@ impl Lights {
     /// Whether some shadow rays toward the lights are bounded by no shaft
     /// ([`Lights::shaft_light_of`]): rays toward an environment, a delta light, or an
     /// area light no shaft bounds.
+    #[inline]
     pub(crate) fn some_rays_unbounded(&self) -> bool {
-        self.environment.is_some()
-            || !self.delta.is_empty()
-            || self.bounded_by_shafts.iter().any(|&bounded| !bounded)
+        self.some_unbounded
     }
 
     /// The area light whose point `source` is, where a shaft bounds its rays

@@ -46,11 +46,10 @@ pub(super) enum Brings {
     Sky(SkyLookup),
 }
 
-/// What a candidate that meets the map brings, but for the map's numbers.
+/// What a candidate that meets the map brings, but for the map's numbers (its direction
+/// is its shadow ray's).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct SkyLookup {
-    /// The candidate's direction.
-    pub direction: Vec3,
     /// Where it falls on the map, if it was drawn from the map.
     pub location: Option<MapLocation>,
     /// The BSDF times the cosine toward it.
@@ -192,18 +191,19 @@ fn add(value: &mut [f32; 3], brought: Vec3, weight: f32) {
 #[inline(always)]
 fn look_up(map: &EnvironmentMap, left: &[Left], run: &[usize], values: &mut [[f32; 3]]) {
     let lookup = |i: usize| match left[i].brings {
-        Brings::Sky(lookup) => lookup,
+        Brings::Sky(lookup) => (left[i].ray.direction, lookup),
         Brings::Value(_) => unreachable!("a run holds the map's candidates"),
     };
     // Lanes past the run hold a unit direction, looked up for nothing.
     let mut directions = [Vec3::Z; MAP_LANES];
     let mut known = [None; MAP_LANES];
     for (k, &i) in run.iter().enumerate() {
-        (directions[k], known[k]) = (lookup(i).direction, lookup(i).location);
+        let (direction, lookup) = lookup(i);
+        (directions[k], known[k]) = (direction, lookup.location);
     }
     let (locations, radiances) = map.look_up_lanes(&directions, &known);
     for (k, &i) in run.iter().enumerate() {
-        let lookup = lookup(i);
+        let (_, lookup) = lookup(i);
         let parts = MisParts {
             bsdf: lookup.bsdf_density,
             light: lookup.choice * map.density_at(locations[k]) as f64,

@@ -360,10 +360,8 @@ impl<'a> PlainLanes<'a> {
         if !(to_sky && unguided_map && lanes.specular[k].is_none()) {
             return Brings::Value(self.brought::<SOURCES>(run, lanes, k));
         }
-        let direction = lanes.direction[k];
-        let (scattering, bsdf_density) = self.bsdf_value_and_density(run, direction);
+        let (scattering, bsdf_density) = self.bsdf_value_and_density(run, lanes.direction[k]);
         Brings::Sky(SkyLookup {
-            direction,
             location: lanes.location[k],
             scattering,
             bsdf_density,
