@@ -2,6 +2,9 @@
 //! a uniform point on it, and its own BVH so that the density of a direction and the
 //! nearest emitting point along a ray cost O(log n) rather than a loop over the triangles.
 //!
+//! Most rays that ask for the nearest emitting point miss the mesh altogether: a test
+//! against a ball around it answers those before the BVH is entered.
+//!
 //! A direction may cross several triangles of a non-convex mesh. Light sampling reaches
 //! each crossing point, and the gather takes the radiance of the nearest one, so the
 //! density of a direction is the sum over all its crossings of distance² / (|cos| · area).
@@ -24,6 +27,8 @@ pub struct MeshEmitter {
     /// Total area.
     area: f64,
     bvh: CwBvh,
+    /// A ball holding every triangle.
+    bounds: Ball,
     /// Each triangle's texture coordinates at its vertices, in BVH order (for a textured
     /// radiance).
     texcoords: Option<Vec<[Vec2; 3]>>,
@@ -56,6 +61,7 @@ impl MeshEmitter {
             .collect();
         MeshEmitter {
             outline: planar_outline(&triangles),
+            bounds: Ball::around(&triangles),
             choice: AliasTable::new(&areas),
             area: areas.iter().sum(),
             triangles,
@@ -132,6 +138,9 @@ impl MeshEmitter {
     /// every triangle the direction crosses.
     pub fn pdf(&self, point: Vec3, direction: Vec3) -> f64 {
         let ray = Ray::new(point, direction);
+        if self.bounds.missed_by(&ray) {
+            return 0.0;
+        }
         let mut density = 0.0;
         self.bvh.ray_traverse(
             ray.to_bvh(f32::INFINITY),
@@ -150,6 +159,9 @@ impl MeshEmitter {
 
     /// The nearest point of the mesh along `ray` (within `ray.t_max`).
     pub fn intersect(&self, ray: &Ray) -> Option<AreaHit> {
+        if self.bounds.missed_by(ray) {
+            return None;
+        }
         let mut hit = obvhs::ray::RayHit::none();
         let mut nearest: Option<(f32, usize, Vec2)> = None;
         self.bvh
@@ -170,6 +182,43 @@ impl MeshEmitter {
                 barycentrics,
             },
         })
+    }
+}
+
+/// A ball around a mesh, a little larger than the vertices reach, so that rounding leaves
+/// no crossing of the mesh outside it.
+#[derive(Clone, Copy, Debug)]
+struct Ball {
+    centre: Vec3,
+    radius: f32,
+}
+
+impl Ball {
+    /// The ball centred on `triangles`' bounding box, through their farthest vertex.
+    fn around(triangles: &[Triangle]) -> Ball {
+        let vertices = || triangles.iter().flat_map(|t| t.vertices);
+        let (low, high) = vertices().fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), v| {
+            (lo.min(v), hi.max(v))
+        });
+        let centre = 0.5 * (low + high);
+        let reach = vertices().map(|v| v.distance(centre)).fold(0.0, f32::max);
+        Ball {
+            centre,
+            radius: reach * 1.001 + 1e-6 * centre.abs().max_element(),
+        }
+    }
+
+    /// Whether `ray` (within its `t_max`) surely meets nothing inside the ball. The
+    /// distance from the centre to the ray's line is taken as a vector's length, not as a
+    /// difference of squares, which cancels for origins far from the ball.
+    #[inline]
+    fn missed_by(&self, ray: &Ray) -> bool {
+        let to_centre = self.centre - ray.origin;
+        let along = to_centre.dot(ray.direction);
+        let beside = to_centre - along * ray.direction;
+        beside.length_squared() > self.radius * self.radius
+            || along < -self.radius
+            || along - self.radius > ray.t_max
     }
 }
 
@@ -256,5 +305,52 @@ mod tests {
         }
         let bent = [triangle([a, b, c]), triangle([a, c, d + Vec3::Y * 0.01])];
         assert!(planar_outline(&bent).is_none());
+    }
+
+    #[test]
+    fn the_ball_around_a_mesh_lets_through_every_ray_that_crosses_it() {
+        let mut rng = ais::rng::Pcg32::new(7, 0);
+        let mut point = |scale: f32| {
+            Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 * scale
+                - Vec3::splat(scale)
+        };
+        // A thin, off-centre cluster of triangles.
+        let centre = Vec3::new(3.0, -1.0, 0.5);
+        let triangles: Vec<Triangle> = (0..40)
+            .map(|_| triangle([0; 3].map(|_| centre + point(1.0) * Vec3::new(1.0, 0.1, 0.6))))
+            .collect();
+        let ball = Ball::around(&triangles);
+        let (mut crossing, mut missed) = (0, 0);
+        for i in 0..20_000 {
+            // Origins from a hundredth to ten thousand times the mesh's size away, aimed
+            // at a vertex (grazing), a point of a triangle, or anywhere near.
+            let origin = centre + point(10f32.powi(i % 7 - 2));
+            let t = &triangles[i as usize % triangles.len()];
+            let aim = match i % 3 {
+                0 => t.vertices[i as usize % 3],
+                1 => (t.vertices[0] + t.vertices[1] + t.vertices[2]) / 3.0,
+                _ => centre + point(3.0),
+            };
+            let Some(direction) = (aim - origin).try_normalize() else {
+                continue;
+            };
+            let ray = Ray::new(origin, direction);
+            if triangles
+                .iter()
+                .any(|t| t.intersect(&ray, f32::INFINITY).is_some())
+            {
+                crossing += 1;
+                assert!(
+                    !ball.missed_by(&ray),
+                    "ray {i} from {origin} crosses the mesh"
+                );
+            } else if ball.missed_by(&ray) {
+                missed += 1;
+            }
+        }
+        assert!(
+            crossing > 5_000 && missed > 2_000,
+            "{crossing} crossing, {missed} missed"
+        );
     }
 }
