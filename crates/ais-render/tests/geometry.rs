@@ -201,6 +201,37 @@ fn rays_from_one_origin_are_answered_alike_after_a_blocker() {
     );
 }
 
+#[test]
+fn a_blocker_a_hair_from_the_origin_blocks_in_the_traversal_as_after_a_blocker() {
+    // A flat floor: its boxes are flat too, so a box test that started at some distance
+    // would pass over a floor closer than that.
+    let floor = [
+        (0.0, 0.0),
+        (1.0, 0.0),
+        (1.0, 1.0),
+        (0.0, 0.0),
+        (1.0, 1.0),
+        (0.0, 1.0),
+    ];
+    let geometry = Geometry::build(vec![triangles_shape(
+        floor.iter().map(|&(x, z)| Vec3::new(x, 0.0, z)).collect(),
+    )]);
+    for height in [3e-5, 6e-5, 9e-5, 2e-4] {
+        let ray = Ray::new(Vec3::new(0.3, height, 0.6), Vec3::NEG_Y);
+        assert!(geometry.intersect_brute_force(&ray).is_some());
+        assert!(
+            geometry.occluded(&ray),
+            "{height} above the floor, traversed"
+        );
+        let mut blockers = RecentBlockers::default();
+        assert!(geometry.occluded_after(&ray, &mut blockers));
+        assert!(
+            geometry.occluded_after(&ray, &mut blockers),
+            "{height} above the floor, after a blocker"
+        );
+    }
+}
+
 /// A shape of one mesh from `positions`, three per triangle.
 fn triangles_shape(positions: Vec<Vec3>) -> ShapeInput {
     let triangles = (0..positions.len() as u32 / 3)

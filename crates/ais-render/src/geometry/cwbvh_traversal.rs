@@ -196,7 +196,11 @@ fn indices(base: u32, mut mask: u32) -> impl Iterator<Item = usize> {
 /// obvhs's own test (`CwBvhNode::intersect_ray`) does the same arithmetic four children at a
 /// time with SSE; here the eight children's boxes are tested in one pass that the compiler
 /// vectorises (AVX), each comparison as the SSE instruction makes it (`max(a, b)` is
-/// `a > b ? a : b`), so the same children are entered.
+/// `a > b ? a : b`), so the same children are entered. One difference: a box is entered
+/// from the ray's own `tmin` (0 for this renderer's rays), where obvhs starts every box at
+/// 1e-4. Otherwise a blocker within 1e-4 of a ray's origin was found or not depending on
+/// whether its leaf's box reached past 1e-4, and [`super::RecentBlockers`], which tests a
+/// remembered triangle directly, disagreed with the traversal there.
 #[inline(always)]
 fn children_hit(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
     let scale = node.compute_extent() * ray.inv_direction;
@@ -223,7 +227,7 @@ fn children_hit(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
             plane(far_x[child], 0),
             sse_min(plane(far_y[child], 1), plane(far_z[child], 2)),
         );
-        entered[child] = sse_max(t_near, NODE_EPSILON) <= sse_min(t_far, ray.tmax);
+        entered[child] = sse_max(t_near, ray.tmin) <= sse_min(t_far, ray.tmax);
     }
     let (child_bits, bit_index) = node.get_child_and_index_bits(oct_inv4);
     (0..8).fold(0, |mask, child| {
@@ -231,9 +235,6 @@ fn children_hit(node: &CwBvhNode, ray: &obvhs::ray::Ray, oct_inv4: u32) -> u32 {
         mask | (byte(child_bits) * entered[child] as u32) << byte(bit_index)
     })
 }
-
-/// The nearest distance obvhs's node test lets a box start at.
-const NODE_EPSILON: f32 = 0.0001;
 
 /// SSE's `maxps`: `b` unless `a > b` (so `b` when either is NaN).
 #[inline(always)]
@@ -299,7 +300,9 @@ mod tests {
             } else {
                 10.0 * rng_free(i)
             };
-            let bvh_ray = ray.to_bvh(ray.t_max);
+            let mut bvh_ray = ray.to_bvh(ray.t_max);
+            // obvhs starts every box at 1e-4 whatever the ray's tmin.
+            bvh_ray.tmin = 1e-4;
             let state = bvh.new_traversal(bvh_ray.direction);
             for node in &bvh.nodes {
                 let expected = node.intersect_ray(&bvh_ray, state.oct_inv4);
