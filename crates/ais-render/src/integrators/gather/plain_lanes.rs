@@ -126,7 +126,9 @@ struct Lanes {
     /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
     specular: [Option<SpecularMass>; RUN],
     /// Whether its shadow ray is left to the pixel's pool to trace (then `free` holds until
-    /// the pool finds otherwise), and the point the ray ends at, if it ends.
+    /// the pool finds otherwise), and the point the ray ends at, if it ends. Both are set
+    /// only for candidates whose ray is needed, and read only where `free` is set: a lane
+    /// whose ray is not needed may hold an earlier run's.
     deferred: [bool; RUN],
     target: [Option<Vec3>; RUN],
 }
