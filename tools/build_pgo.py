@@ -84,6 +84,16 @@ def train(binary, scenes):
 
 
 def main():
+    try:
+        build_and_train()
+    except FileNotFoundError as error:
+        sys.exit(f"build_pgo: {error.filename} not found: install the Rust toolchain (rustup) first")
+    except subprocess.CalledProcessError as error:
+        sys.exit(f"build_pgo: `{' '.join(error.cmd)}` failed (exit {error.returncode})")
+
+
+def build_and_train():
+    """The three steps, as the module's text describes them."""
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--train", nargs="+", default=[], help="scene files (or `default`) to train on")
     parser.add_argument("--exclude", nargs="+", default=[], help="scene files (or `default`) to leave out of training")
@@ -94,6 +104,9 @@ def main():
     scenes = training_scenes(args)
     if not scenes:
         sys.exit("build_pgo: no scene left to train on")
+    missing = [scene for scene in scenes if scene != "default" and not os.path.isfile(scene)]
+    if missing:
+        sys.exit(f"build_pgo: no scene file {missing[0]}")
     profiles = os.path.join(TARGET, "profiles")
     shutil.rmtree(profiles, ignore_errors=True)
     instrumented = build(os.path.join(TARGET, "instrumented"), [f"-Cprofile-generate={profiles}"])
