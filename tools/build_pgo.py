@@ -14,7 +14,7 @@ Three steps:
    (`-C profile-use`) into target/pgo/release/ais.
 
 The flags of .cargo/config.toml (the building CPU's vector units) are kept: RUSTFLAGS would
-replace them, so they are given again here. The assets of scenes/ are made first if missing
+replace them, so they are read from it and given again. The assets of scenes/ are made first if missing
 (scenes/make_assets.py).
 """
 import argparse
@@ -24,10 +24,16 @@ import shutil
 import subprocess
 import sys
 import tempfile
+import tomllib
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 TARGET = os.path.join(ROOT, "target", "pgo")
-FLAGS = ["-C", "target-cpu=native"]
+
+
+def config_flags():
+    """The rustflags of .cargo/config.toml, which RUSTFLAGS would otherwise replace."""
+    with open(os.path.join(ROOT, ".cargo", "config.toml"), "rb") as config:
+        return tomllib.load(config).get("build", {}).get("rustflags", [])
 
 
 def llvm_profdata():
@@ -46,7 +52,7 @@ def llvm_profdata():
 
 def build(target_dir, flags):
     """`cargo build --release -p ais-cli` into `target_dir` with `flags` as RUSTFLAGS."""
-    environment = dict(os.environ, RUSTFLAGS=" ".join(FLAGS + flags))
+    environment = dict(os.environ, RUSTFLAGS=" ".join(config_flags() + flags))
     command = ["cargo", "build", "--release", "--locked", "-p", "ais-cli", "--target-dir", target_dir]
     print("build_pgo:", " ".join(command), f"(RUSTFLAGS={environment['RUSTFLAGS']})", flush=True)
     subprocess.run(command, cwd=ROOT, env=environment, check=True)
@@ -104,7 +110,7 @@ def build_and_train():
     scenes = training_scenes(args)
     if not scenes:
         sys.exit("build_pgo: no scene left to train on")
-    missing = [scene for scene in scenes if scene != "default" and not os.path.isfile(scene)]
+    missing = [scene for scene in scenes if name(scene) != "default" and not os.path.isfile(scene)]
     if missing:
         sys.exit(f"build_pgo: no scene file {missing[0]}")
     profiles = os.path.join(TARGET, "profiles")
