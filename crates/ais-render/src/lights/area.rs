@@ -306,6 +306,15 @@ impl AreaLight {
         (receiver.support_side).is_some_and(|side| self.wholly_behind(receiver.point, side))
     }
 
+    /// The triangles of an emitting mesh.
+    #[inline]
+    pub(super) fn mesh(&self) -> Option<&MeshEmitter> {
+        match &self.shape {
+            AreaShape::Triangles(mesh) => Some(mesh),
+            _ => None,
+        }
+    }
+
     /// The rectangle of a rectangle light.
     #[inline]
     pub(super) fn rectangle(&self) -> Option<&Rectangle> {

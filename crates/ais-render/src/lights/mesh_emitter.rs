@@ -95,7 +95,22 @@ impl MeshEmitter {
     /// in solid angle of drawing that point ([`MeshEmitter::pdf`] sums it over every
     /// crossing of the direction), its distance and the triangle's normal.
     pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<AreaSample> {
-        let (index, u0) = self.choice.sample(u[0]);
+        self.sample_on(point, self.pick(u[0]), u[1])
+    }
+
+    /// The first step of [`MeshEmitter::sample`]: a triangle drawn from `u0` by area, and
+    /// what is left of `u0`.
+    #[inline]
+    pub fn pick(&self, u0: f32) -> (usize, f32) {
+        self.choice.sample(u0)
+    }
+
+    /// The second step of [`MeshEmitter::sample`]: a point of the triangle `picked` (from
+    /// [`MeshEmitter::pick`]) drawn with what was left of its number and `u1`.
+    #[inline]
+    pub fn sample_on(&self, point: Vec3, picked: (usize, f32), u1: f32) -> Option<AreaSample> {
+        let (index, u0) = picked;
+        let u = [u0, u1];
         let triangle = &self.triangles[index];
         let su = u0.sqrt();
         let (b1, b2) = (1.0 - su, u[1] * su);

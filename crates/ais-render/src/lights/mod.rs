@@ -3,6 +3,7 @@
 //! alias table: O(1) per choice).
 
 mod area;
+mod area_draws;
 mod delta;
 mod draw;
 mod environment;
@@ -11,13 +12,13 @@ mod environment_guide;
 mod mesh_emitter;
 pub(crate) mod reader;
 mod receiver;
-mod rectangle_draws;
 mod regions;
 mod resolve;
 mod spherical_rectangle;
 mod toward;
 
 pub use area::{AreaHit, AreaLight, AreaSample, AreaShape, LightSpot};
+pub use area_draws::{AreaChoice, AreaDraw, AreaDraws};
 pub use delta::{DeltaArrival, DeltaLight, Spot};
 pub use draw::Draw;
 pub(crate) use environment::LANES as MAP_LANES;
@@ -26,7 +27,6 @@ pub use environment_draws::EnvironmentDraws;
 pub use environment_guide::{EnvironmentGuide, EnvironmentPartition, GuideLayout, MapWeights};
 pub use mesh_emitter::MeshEmitter;
 pub use receiver::Receiver;
-pub use rectangle_draws::{AreaChoice, RectangleDraw, RectangleDraws};
 pub use regions::{region_of, RegionChoice, REGIONS, REGION_SIDE};
 pub(crate) use spherical_rectangle::LANES;
 pub use spherical_rectangle::{Rectangle, LEAST_F32_SOLID_ANGLE};
@@ -299,7 +299,7 @@ impl Lights {
         match draw {
             Draw::Made(toward) => toward,
             Draw::Environment(u) => self.environment_toward(receiver, u),
-            Draw::Rectangle(draw) => {
+            Draw::Area(draw) => {
                 let light = &self.area[draw.choice.light];
                 let sample = light.sample_for(receiver, draw.square)?;
                 Some(self.area_toward(receiver, draw.choice, &sample))
@@ -307,9 +307,9 @@ impl Lights {
         }
     }
 
-    /// [`Lights::sample_toward`], except that a draw from an environment map or a rectangle
-    /// light is left to be made together with other candidates' ([`EnvironmentDraws`],
-    /// [`RectangleDraws`]).
+    /// [`Lights::sample_toward`], except that a draw from an environment map, a rectangle
+    /// light or an emitting mesh is left to be made together with other candidates' ([`EnvironmentDraws`],
+    /// [`AreaDraws`]).
     #[inline]
     pub fn begin_sample(&self, receiver: &Receiver, u: [f32; 2]) -> Draw {
         let Some(choice) = self.choice_for(receiver) else {
@@ -332,7 +332,8 @@ impl Lights {
     }
 
     /// A point of area light `index` (chosen with `probability`) drawn from `square` for
-    /// `receiver`: made now, or, for a rectangle, left to be made with the run's others.
+    /// `receiver`: made now, or, for a rectangle or a mesh, left to be made with the run's
+    /// others.
     #[inline]
     fn begin_area(
         &self,
@@ -356,8 +357,9 @@ impl Lights {
             factor,
             region: region as u8,
         };
-        if light.rectangle().is_some() && !light.out_of_reach(receiver) {
-            return Draw::Rectangle(RectangleDraw { choice, square });
+        let held = light.rectangle().is_some() || light.mesh().is_some();
+        if held && !light.out_of_reach(receiver) {
+            return Draw::Area(AreaDraw { choice, square });
         }
         let sample = light.sample_for(receiver, square);
         Draw::Made(sample.map(|sample| self.area_toward(receiver, choice, &sample)))

@@ -12,7 +12,7 @@ use super::settings::GatherSettings;
 use super::shared_origin::SharedOrigin;
 use super::strategy::{CandidateDraw, GatherPoint, MisParts};
 use crate::geometry::RecentBlockers;
-use crate::lights::{luminance, EnvironmentDraws, RectangleDraws, Toward};
+use crate::lights::{luminance, AreaDraws, EnvironmentDraws, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
 use ais::field::{CellRecorder, FieldCell};
@@ -335,11 +335,11 @@ fn keep_in_support(at: &GatherPoint, drawn: &mut [Option<Toward>]) -> usize {
 /// Draws the candidates of `numbers` into `slots` (as many), in order: `None` where no
 /// direction could be drawn. The environment map's draws are made all together, step by
 /// step, so that one draw's table lookups overlap the next's; a rectangle light's after
-/// them, over the run's lanes at once, and the BSDF's last (a diffuse material's in lanes
-/// too).
+/// them, over the run's lanes at once (an emitting mesh's together too), and the BSDF's
+/// last (a diffuse material's in lanes too).
 fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>]) {
     let mut environment = EnvironmentDraws::default();
-    let mut rectangles = RectangleDraws::default();
+    let mut area_draws = AreaDraws::default();
     let mut bsdf_numbers = [[0.0; 2]; AHEAD];
     let mut bsdf_slots = [0; AHEAD];
     let mut bsdf_draws = 0;
@@ -350,8 +350,8 @@ fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>])
                 environment.push(k, u);
                 None
             }
-            CandidateDraw::Rectangle(draw) => {
-                rectangles.push(k, draw);
+            CandidateDraw::Area(draw) => {
+                area_draws.push(k, draw);
                 None
             }
             CandidateDraw::Bsdf(u) => {
@@ -364,7 +364,7 @@ fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>])
     environment.draw(run.at.lights, &run.at.receiver, |k, toward| {
         slots[k] = Some(toward)
     });
-    rectangles.draw(run.at.lights, &run.at.receiver, |k, toward| {
+    area_draws.draw(run.at.lights, &run.at.receiver, |k, toward| {
         slots[k] = Some(toward)
     });
     run.at

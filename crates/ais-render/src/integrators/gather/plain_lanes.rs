@@ -14,8 +14,8 @@ use super::shared_origin::SharedOrigin;
 use super::strategy::{MisParts, MisPick, Strategy};
 use crate::bsdf::{diffuse_direction, DiffuseHit, SpecularMass};
 use crate::lights::{
-    Aim, Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap, MapLocation,
-    MapWeights, Receiver, RectangleDraws, Source, Toward, LANES,
+    Aim, AreaDraws, Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap,
+    MapLocation, MapWeights, Receiver, Source, Toward, LANES,
 };
 use crate::render::RayCounts;
 use glam::Vec3;
@@ -260,7 +260,7 @@ impl<'a> PlainLanes<'a> {
     }
 
     /// Draws the candidates of `numbers` into `lanes`: the map's all together
-    /// ([`EnvironmentDraws`]), then the rectangle lights' ([`RectangleDraws`]), then the
+    /// ([`EnvironmentDraws`]), then the rectangle and mesh lights' ([`AreaDraws`]), then the
     /// BSDF's ([`GatherPoint::draw_bsdf_run`]), and which carry light to the viewer
     /// ([`GatherPoint::carries`]).
     ///
@@ -270,7 +270,7 @@ impl<'a> PlainLanes<'a> {
     fn draw<const SOURCES: bool>(&self, run: &BatchRun, numbers: &[[f32; 2]], lanes: &mut Lanes) {
         let at = run.at;
         let mut environment = EnvironmentDraws::default();
-        let mut rectangles = RectangleDraws::default();
+        let mut area_draws = AreaDraws::default();
         let mut bsdf_numbers = [[0.0; 2]; RUN];
         let mut bsdf_slots = [0; RUN];
         let mut bsdf_draws = 0;
@@ -292,7 +292,7 @@ impl<'a> PlainLanes<'a> {
             };
             match at.lights.begin_sample(&at.receiver, u) {
                 Draw::Environment(u) => environment.push(k, u),
-                Draw::Rectangle(draw) => rectangles.push(k, draw),
+                Draw::Area(draw) => area_draws.push(k, draw),
                 Draw::Made(Some(toward)) => lanes.put::<SOURCES>(k, &toward, toward.source()),
                 Draw::Made(None) => {}
             }
@@ -301,7 +301,7 @@ impl<'a> PlainLanes<'a> {
         environment.draw(at.lights, receiver, |k, toward| {
             lanes.put::<SOURCES>(k, &toward, Source::Environment);
         });
-        rectangles.draw(at.lights, receiver, |k, toward| {
+        area_draws.draw(at.lights, receiver, |k, toward| {
             lanes.put::<SOURCES>(k, &toward, toward.source());
         });
         at.draw_bsdf_run(&bsdf_numbers[..bsdf_draws], |i, toward| {

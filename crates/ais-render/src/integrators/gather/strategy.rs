@@ -3,7 +3,7 @@
 
 use crate::bsdf::{diffuse_direction, HitBsdf, ShadingFrame, SurfacePoint};
 use crate::geometry::Hit;
-use crate::lights::{Draw, Lights, Receiver, RectangleDraw, Toward};
+use crate::lights::{AreaDraw, Draw, Lights, Receiver, Toward};
 use crate::world::World;
 use ais::sampling::uniform_sphere;
 use glam::Vec3;
@@ -118,9 +118,7 @@ impl GatherPoint<'_> {
             CandidateDraw::Environment(u) => {
                 self.lights.finish(&self.receiver, Draw::Environment(u))
             }
-            CandidateDraw::Rectangle(draw) => {
-                self.lights.finish(&self.receiver, Draw::Rectangle(draw))
-            }
+            CandidateDraw::Area(draw) => self.lights.finish(&self.receiver, Draw::Area(draw)),
             CandidateDraw::Bsdf(u) => self.sample_bsdf(u),
         }
     }
@@ -163,15 +161,16 @@ const BSDF_LANES: usize = 16;
 
 /// A candidate's draw from a proposal: made, or left to be made with the run's other draws
 /// of its kind (an environment map's, [`crate::lights::EnvironmentDraws`]; a rectangle
-/// light's, [`crate::lights::RectangleDraws`]; a BSDF's, [`GatherPoint::draw_bsdf_run`]).
+/// light's or an emitting mesh's, [`crate::lights::AreaDraws`]; a BSDF's,
+/// [`GatherPoint::draw_bsdf_run`]).
 #[derive(Clone, Copy, Debug)]
 pub enum CandidateDraw {
     /// The draw is made (`None`: no direction).
     Made(Option<Toward>),
     /// A direction from the environment map for these numbers is still to be drawn.
     Environment([f32; 2]),
-    /// A point of a rectangle light is still to be drawn.
-    Rectangle(RectangleDraw),
+    /// A point of a rectangle light or an emitting mesh is still to be drawn.
+    Area(AreaDraw),
     /// A direction from the BSDF for these numbers is still to be drawn.
     Bsdf([f32; 2]),
 }
@@ -181,7 +180,7 @@ impl From<Draw> for CandidateDraw {
         match draw {
             Draw::Made(toward) => CandidateDraw::Made(toward),
             Draw::Environment(u) => CandidateDraw::Environment(u),
-            Draw::Rectangle(draw) => CandidateDraw::Rectangle(draw),
+            Draw::Area(draw) => CandidateDraw::Area(draw),
         }
     }
 }
@@ -236,7 +235,7 @@ impl Strategy {
     }
 
     /// [`Strategy::sample_direction`], except that a draw from an environment map, a
-    /// rectangle light or the BSDF is left to be made together with other candidates' of
+    /// rectangle light, an emitting mesh or the BSDF is left to be made together with other candidates' of
     /// its kind ([`CandidateDraw`]).
     #[inline]
     pub fn begin_direction(self, at: &GatherPoint, u: [f32; 2]) -> CandidateDraw {
