@@ -148,6 +148,31 @@ impl SphereView {
         1.0 / (2.0 * PI * (1.0 - self.cos_max))
     }
 
+    /// A point of `sphere` (seen from `point` as this view) drawn uniformly in the cone's
+    /// solid angle from `u`; its normal faces inward where the sphere's normals are
+    /// `flipped`.
+    #[inline]
+    fn sample(&self, sphere: &Sphere, flipped: bool, point: Vec3, u: [f32; 2]) -> AreaSample {
+        // The cone's angle in f64 (a small cone's 1 − cos θ is below f32's resolution at
+        // 1); the azimuth needs no more than f32.
+        let cos_theta = 1.0 - u[0] as f64 * (1.0 - self.cos_max);
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt() as f32;
+        let (sin_phi, cos_phi) = ais::fast_trig::sin_cos(std::f32::consts::TAU * u[1]);
+        let (t, b) = crate::geometry::basis(self.axis);
+        let direction =
+            (t * (sin_theta * cos_phi) + b * (sin_theta * sin_phi) + self.axis * cos_theta as f32)
+                .normalize();
+        let distance = self.distance_at(cos_theta) as f32;
+        let outward = (point + direction * distance - sphere.center) / sphere.radius;
+        AreaSample {
+            direction,
+            pdf: self.density(),
+            distance,
+            normal: if flipped { -outward } else { outward },
+            spot: LightSpot::default(),
+        }
+    }
+
     /// How far the near side of the sphere is along a direction at `cos_theta` from the
     /// axis (within the cone): the near root of the ray's quadratic, in closed form. At
     /// the rim, where rounding puts the direction just outside, the tangent point.
@@ -240,25 +265,7 @@ impl AreaLight {
         match &self.shape {
             AreaShape::Sphere { sphere, flipped } => {
                 let cone = SphereView::new(sphere, point)?;
-                // The cone's angle in f64 (a small cone's 1 − cos θ is below f32's
-                // resolution at 1); the azimuth needs no more than f32.
-                let cos_theta = 1.0 - u[0] as f64 * (1.0 - cone.cos_max);
-                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt() as f32;
-                let (sin_phi, cos_phi) = ais::fast_trig::sin_cos(std::f32::consts::TAU * u[1]);
-                let (t, b) = crate::geometry::basis(cone.axis);
-                let direction = (t * (sin_theta * cos_phi)
-                    + b * (sin_theta * sin_phi)
-                    + cone.axis * cos_theta as f32)
-                    .normalize();
-                let distance = cone.distance_at(cos_theta) as f32;
-                let outward = (point + direction * distance - sphere.center) / sphere.radius;
-                Some(AreaSample {
-                    direction,
-                    pdf: cone.density(),
-                    distance,
-                    normal: if *flipped { -outward } else { outward },
-                    spot: LightSpot::default(),
-                })
+                Some(cone.sample(sphere, *flipped, point, u))
             }
             AreaShape::Rectangle(rectangle) => {
                 let (direction, pdf, distance) = receiver
@@ -306,12 +313,52 @@ impl AreaLight {
         (receiver.support_side).is_some_and(|side| self.wholly_behind(receiver.point, side))
     }
 
-    /// The triangles of an emitting mesh.
-    #[inline]
-    pub(super) fn mesh(&self) -> Option<&MeshEmitter> {
+    /// [`AreaLight::sample_for`] for each of `squares`, the points given to `put` with their
+    /// index in `squares` (none where no point is drawn): the draws of a run of candidates,
+    /// made so that they overlap. A rectangle's view is read once and its draws worked out
+    /// over vector lanes ([`Rectangle::sample_view_run`]); a sphere's view is worked out
+    /// once; a mesh's triangles are all picked before any point is drawn
+    /// ([`MeshEmitter::sample_run`]). The points are the same to the bit as one draw at a
+    /// time.
+    #[inline(always)]
+    pub(super) fn sample_run(
+        &self,
+        receiver: &Receiver,
+        squares: &[[f32; 2]],
+        mut put: impl FnMut(usize, &AreaSample),
+    ) {
+        if self.out_of_reach(receiver) {
+            return;
+        }
+        let point = receiver.point;
         match &self.shape {
-            AreaShape::Triangles(mesh) => Some(mesh),
-            _ => None,
+            AreaShape::Rectangle(rectangle) => {
+                let Some(view) = receiver.with_rectangle_view(rectangle, |view| *view) else {
+                    return;
+                };
+                Rectangle::sample_view_run(&view, squares, |k, direction, pdf, distance| {
+                    put(
+                        k,
+                        &AreaSample::on_rectangle(rectangle, direction, pdf, distance),
+                    )
+                });
+            }
+            AreaShape::Sphere { sphere, flipped } => {
+                let Some(cone) = SphereView::new(sphere, point) else {
+                    return;
+                };
+                for (k, &u) in squares.iter().enumerate() {
+                    put(k, &cone.sample(sphere, *flipped, point, u));
+                }
+            }
+            AreaShape::Triangles(mesh) => mesh.sample_run(point, squares, put),
+            AreaShape::Quadric { .. } => {
+                for (k, &u) in squares.iter().enumerate() {
+                    if let Some(sample) = self.sample_for(receiver, u) {
+                        put(k, &sample);
+                    }
+                }
+            }
         }
     }
 

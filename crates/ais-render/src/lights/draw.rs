@@ -1,7 +1,7 @@
 //! A candidate's draw by light sampling, made at once or left to be made together with the
 //! other draws of its kind in a run of candidates, whose steps then overlap or run in
-//! vector lanes: an environment map's ([`super::EnvironmentDraws`]), and a rectangle
-//! light's or an emitting mesh's ([`super::AreaDraws`]).
+//! vector lanes: an environment map's ([`super::EnvironmentDraws`]) and an area light's
+//! ([`super::AreaDraws`]).
 
 use super::{AreaDraw, Toward};
 
@@ -12,7 +12,7 @@ pub enum Draw {
     Made(Option<Toward>),
     /// A direction from the environment map for these numbers is still to be drawn.
     Environment([f32; 2]),
-    /// A point of a rectangle light or an emitting mesh is still to be drawn.
+    /// A point of an area light is still to be drawn.
     Area(AreaDraw),
 }
 

@@ -10,6 +10,7 @@
 //! density of a direction is the sum over all its crossings of distance² / (|cos| · area).
 
 use super::area::{AreaHit, LightSpot};
+use super::draw::RUN;
 use super::AreaSample;
 use crate::geometry::{Ray, Triangle};
 use ais::sampling::AliasTable;
@@ -98,17 +99,39 @@ impl MeshEmitter {
         self.sample_on(point, self.pick(u[0]), u[1])
     }
 
+    /// [`MeshEmitter::sample`] for each of `squares` (at most [`RUN`]), the points given to
+    /// `put` with their index in `squares`: every triangle picked first, then every point.
+    /// A draw waits on two lookups, the triangle's alias bin and then its vertices; made
+    /// in two passes, the run's waits overlap.
+    #[inline(always)]
+    pub fn sample_run(
+        &self,
+        point: Vec3,
+        squares: &[[f32; 2]],
+        mut put: impl FnMut(usize, &AreaSample),
+    ) {
+        let mut picks = [(0, 0.0); RUN];
+        for (pick, square) in picks.iter_mut().zip(squares) {
+            *pick = self.pick(square[0]);
+        }
+        for (k, (&pick, square)) in picks.iter().zip(squares).enumerate() {
+            if let Some(sample) = self.sample_on(point, pick, square[1]) {
+                put(k, &sample);
+            }
+        }
+    }
+
     /// The first step of [`MeshEmitter::sample`]: a triangle drawn from `u0` by area, and
     /// what is left of `u0`.
     #[inline]
-    pub fn pick(&self, u0: f32) -> (usize, f32) {
+    fn pick(&self, u0: f32) -> (usize, f32) {
         self.choice.sample(u0)
     }
 
     /// The second step of [`MeshEmitter::sample`]: a point of the triangle `picked` (from
     /// [`MeshEmitter::pick`]) drawn with what was left of its number and `u1`.
     #[inline]
-    pub fn sample_on(&self, point: Vec3, picked: (usize, f32), u1: f32) -> Option<AreaSample> {
+    fn sample_on(&self, point: Vec3, picked: (usize, f32), u1: f32) -> Option<AreaSample> {
         let (index, u0) = picked;
         let u = [u0, u1];
         let triangle = &self.triangles[index];

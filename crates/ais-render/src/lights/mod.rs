@@ -307,8 +307,8 @@ impl Lights {
         }
     }
 
-    /// [`Lights::sample_toward`], except that a draw from an environment map, a rectangle
-    /// light or an emitting mesh is left to be made together with other candidates' ([`EnvironmentDraws`],
+    /// [`Lights::sample_toward`], except that a draw from an environment map or an area light
+    /// is left to be made together with other candidates' ([`EnvironmentDraws`],
     /// [`AreaDraws`]).
     #[inline]
     pub fn begin_sample(&self, receiver: &Receiver, u: [f32; 2]) -> Draw {
@@ -332,8 +332,8 @@ impl Lights {
     }
 
     /// A point of area light `index` (chosen with `probability`) drawn from `square` for
-    /// `receiver`: made now, or, for a rectangle or a mesh, left to be made with the run's
-    /// others.
+    /// `receiver`, left to be made with the run's others (nothing where the light lies wholly
+    /// behind the receiver's support).
     #[inline]
     fn begin_area(
         &self,
@@ -357,12 +357,10 @@ impl Lights {
             factor,
             region: region as u8,
         };
-        let held = light.rectangle().is_some() || light.mesh().is_some();
-        if held && !light.out_of_reach(receiver) {
-            return Draw::Area(AreaDraw { choice, square });
+        match light.out_of_reach(receiver) {
+            true => Draw::Made(None),
+            false => Draw::Area(AreaDraw { choice, square }),
         }
-        let sample = light.sample_for(receiver, square);
-        Draw::Made(sample.map(|sample| self.area_toward(receiver, choice, &sample)))
     }
 
     /// The candidate toward the point `sample` drew on the light of `choice`.

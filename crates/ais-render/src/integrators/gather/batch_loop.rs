@@ -334,9 +334,9 @@ fn keep_in_support(at: &GatherPoint, drawn: &mut [Option<Toward>]) -> usize {
 
 /// Draws the candidates of `numbers` into `slots` (as many), in order: `None` where no
 /// direction could be drawn. The environment map's draws are made all together, step by
-/// step, so that one draw's table lookups overlap the next's; a rectangle light's after
-/// them, over the run's lanes at once (an emitting mesh's together too), and the BSDF's
-/// last (a diffuse material's in lanes too).
+/// step, so that one draw's table lookups overlap the next's; the area lights' after them,
+/// light by light (a rectangle's over the run's lanes at once), and the BSDF's last (a
+/// diffuse material's in lanes too).
 fn draw_into(run: &BatchRun, numbers: &[[f32; 2]], slots: &mut [Option<Toward>]) {
     let mut environment = EnvironmentDraws::default();
     let mut area_draws = AreaDraws::default();

@@ -260,7 +260,7 @@ impl<'a> PlainLanes<'a> {
     }
 
     /// Draws the candidates of `numbers` into `lanes`: the map's all together
-    /// ([`EnvironmentDraws`]), then the rectangle and mesh lights' ([`AreaDraws`]), then the
+    /// ([`EnvironmentDraws`]), then the area lights' ([`AreaDraws`]), then the
     /// BSDF's ([`GatherPoint::draw_bsdf_run`]), and which carry light to the viewer
     /// ([`GatherPoint::carries`]).
     ///

@@ -160,16 +160,15 @@ impl GatherPoint<'_> {
 const BSDF_LANES: usize = 16;
 
 /// A candidate's draw from a proposal: made, or left to be made with the run's other draws
-/// of its kind (an environment map's, [`crate::lights::EnvironmentDraws`]; a rectangle
-/// light's or an emitting mesh's, [`crate::lights::AreaDraws`]; a BSDF's,
-/// [`GatherPoint::draw_bsdf_run`]).
+/// of its kind (an environment map's, [`crate::lights::EnvironmentDraws`]; an area
+/// light's, [`crate::lights::AreaDraws`]; a BSDF's, [`GatherPoint::draw_bsdf_run`]).
 #[derive(Clone, Copy, Debug)]
 pub enum CandidateDraw {
     /// The draw is made (`None`: no direction).
     Made(Option<Toward>),
     /// A direction from the environment map for these numbers is still to be drawn.
     Environment([f32; 2]),
-    /// A point of a rectangle light or an emitting mesh is still to be drawn.
+    /// A point of an area light is still to be drawn.
     Area(AreaDraw),
     /// A direction from the BSDF for these numbers is still to be drawn.
     Bsdf([f32; 2]),
@@ -234,9 +233,9 @@ impl Strategy {
         at.finish(self.begin_direction(at, u))
     }
 
-    /// [`Strategy::sample_direction`], except that a draw from an environment map, a
-    /// rectangle light, an emitting mesh or the BSDF is left to be made together with other candidates' of
-    /// its kind ([`CandidateDraw`]).
+    /// [`Strategy::sample_direction`], except that a draw from an environment map, an area
+    /// light or the BSDF is left to be made together with other candidates' of its kind
+    /// ([`CandidateDraw`]).
     #[inline]
     pub fn begin_direction(self, at: &GatherPoint, u: [f32; 2]) -> CandidateDraw {
         match self.effective(at) {
