@@ -10,7 +10,7 @@ use super::{AreaDraw, Toward};
 pub enum Draw {
     /// The draw is made (`None`: no direction).
     Made(Option<Toward>),
-    /// A direction from the environment map for these numbers is still to be drawn.
+    /// A direction from the environment for these numbers is still to be drawn.
     Environment([f32; 2]),
     /// A point of an area light is still to be drawn.
     Area(AreaDraw),

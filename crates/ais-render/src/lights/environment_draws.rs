@@ -6,7 +6,10 @@
 //! candidate at a time, with a candidate's other work between two draws, each lookup waits
 //! for the one before it. Made step by step over a run, the lookups of different candidates
 //! are independent and the core overlaps them. The directions, and so the images, are the
-//! same to the bit as one draw at a time ([`super::Lights::sample_toward`]).
+//! same to the bit as one draw at a time ([`super::Lights::sample_toward`]). A constant
+//! environment's draws, which look nothing up, are made one at a time here too: held with
+//! the run's others, they come back through a closure rather than as returned values,
+//! which the core would copy through memory.
 
 use super::draw::{HeldDraws, RUN};
 use super::environment::CellPoint;

@@ -307,9 +307,8 @@ impl Lights {
         }
     }
 
-    /// [`Lights::sample_toward`], except that a draw from an environment map or an area light
-    /// is left to be made together with other candidates' ([`EnvironmentDraws`],
-    /// [`AreaDraws`]).
+    /// [`Lights::sample_toward`], except that a draw from the environment or an area light is
+    /// left to be made together with other candidates' ([`EnvironmentDraws`], [`AreaDraws`]).
     #[inline]
     pub fn begin_sample(&self, receiver: &Receiver, u: [f32; 2]) -> Draw {
         let Some(choice) = self.choice_for(receiver) else {
@@ -325,10 +324,7 @@ impl Lights {
             let arrival = self.delta[delta].arrival(receiver.point);
             return Draw::Made(arrival.map(|arrival| Toward::delta(delta, arrival)));
         }
-        match self.environment {
-            Some(Environment::Map(_)) => Draw::Environment([u0, u[1]]),
-            _ => Draw::Made(self.environment_toward(receiver, [u0, u[1]])),
-        }
+        Draw::Environment([u0, u[1]])
     }
 
     /// A point of area light `index` (chosen with `probability`) drawn from `square` for

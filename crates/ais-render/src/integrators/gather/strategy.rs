@@ -166,7 +166,7 @@ const BSDF_LANES: usize = 16;
 pub enum CandidateDraw {
     /// The draw is made (`None`: no direction).
     Made(Option<Toward>),
-    /// A direction from the environment map for these numbers is still to be drawn.
+    /// A direction from the environment for these numbers is still to be drawn.
     Environment([f32; 2]),
     /// A point of an area light is still to be drawn.
     Area(AreaDraw),
