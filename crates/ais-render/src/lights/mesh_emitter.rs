@@ -99,10 +99,10 @@ impl MeshEmitter {
         self.sample_on(point, self.pick(u[0]), u[1])
     }
 
-    /// [`MeshEmitter::sample`] for each of `squares` (at most a run of sixteen), the points given to
-    /// `put` with their index in `squares`: every triangle picked first, then every point.
-    /// A draw waits on two lookups, the triangle's alias bin and then its vertices; made
-    /// in two passes, the run's waits overlap.
+    /// [`MeshEmitter::sample`] for each of `squares` (at most a run of sixteen), the points
+    /// given to `put` with their index in `squares`: every triangle picked first, then
+    /// every point. A draw waits on two lookups, the triangle's alias bin and then its
+    /// vertices; made in two passes, the run's waits overlap.
     #[inline(always)]
     pub fn sample_run(
         &self,
