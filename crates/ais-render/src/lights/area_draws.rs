@@ -49,8 +49,7 @@ impl AreaDraws {
 
     /// Makes every draw held for `receiver`, light by light, and gives each direction to
     /// `put` with its candidate's slot (none where no point is drawn: a rectangle seen
-    /// edge-on, a sphere seen from inside); then holds
-    /// none.
+    /// edge-on, a sphere seen from inside); then holds none.
     pub fn draw(
         &mut self,
         lights: &Lights,
@@ -86,8 +85,7 @@ mod tests {
         AreaLight, AreaShape, Draw, Emitters, Rectangle, RegionChoice, Source, REGIONS,
     };
     use ais::rng::Pcg32;
-    use glam::Vec3;
-    use glam::{DMat4, DVec3};
+    use glam::{DMat4, DVec3, Vec3};
 
     /// A rectangle light with corner `corner` and edges `x`, `y`, of shape `shape_index`.
     fn light(corner: Vec3, x: Vec3, y: Vec3, shape_index: u32, radiance: f32) -> AreaLight {
