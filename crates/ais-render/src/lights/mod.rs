@@ -328,8 +328,9 @@ impl Lights {
     }
 
     /// A point of area light `index` (chosen with `probability`) drawn from `square` for
-    /// `receiver`, left to be made with the run's others (nothing where the light lies wholly
-    /// behind the receiver's support).
+    /// `receiver`, left to be made with the run's others (which draw nothing where the light
+    /// lies wholly behind the receiver's support: [`AreaLight::sample_run`] asks that once
+    /// for the run).
     #[inline]
     fn begin_area(
         &self,
@@ -338,7 +339,6 @@ impl Lights {
         probability: f64,
         square: [f32; 2],
     ) -> Draw {
-        let light = &self.area[index];
         // A receiver that weighs the light's regions draws the square's point from them.
         let (square, region, factor) = match receiver.region_choice(index) {
             Some(regions) => {
@@ -353,10 +353,7 @@ impl Lights {
             factor,
             region: region as u8,
         };
-        match light.out_of_reach(receiver) {
-            true => Draw::Made(None),
-            false => Draw::Area(AreaDraw { choice, square }),
-        }
+        Draw::Area(AreaDraw { choice, square })
     }
 
     /// The candidate toward the point `sample` drew on the light of `choice`.
