@@ -258,10 +258,16 @@ impl AreaLight {
     /// [`AreaLight::sample`] for a receiver that keeps what its other queries can reuse.
     #[inline]
     pub fn sample_for(&self, receiver: &Receiver, u: [f32; 2]) -> Option<AreaSample> {
-        let point = receiver.point;
         if self.out_of_reach(receiver) {
             return None;
         }
+        self.sample_in_reach(receiver, u)
+    }
+
+    /// [`AreaLight::sample_for`] for a receiver the light is known not to lie wholly behind.
+    #[inline]
+    fn sample_in_reach(&self, receiver: &Receiver, u: [f32; 2]) -> Option<AreaSample> {
+        let point = receiver.point;
         match &self.shape {
             AreaShape::Sphere { sphere, flipped } => {
                 let cone = SphereView::new(sphere, point)?;
@@ -354,7 +360,7 @@ impl AreaLight {
             AreaShape::Triangles(mesh) => mesh.sample_run(point, squares, put),
             AreaShape::Quadric { .. } => {
                 for (k, &u) in squares.iter().enumerate() {
-                    if let Some(sample) = self.sample_for(receiver, u) {
+                    if let Some(sample) = self.sample_in_reach(receiver, u) {
                         put(k, &sample);
                     }
                 }
