@@ -59,10 +59,8 @@ impl ReconstructionFilter {
             ReconstructionFilter::Tent { radius } => xs.map(|x| (1.0 - x.abs() / radius).max(0.0)),
             ReconstructionFilter::Gaussian { stddev } => {
                 let alpha = -1.0 / (2.0 * stddev * stddev);
-                let radius = 4.0 * stddev;
-                let at_radius = fast_exp::exp(alpha * radius * radius);
                 let exponentials = fast_exp::exp_lanes(&xs.map(|x| alpha * x * x));
-                exponentials.map(|exponential| (exponential - at_radius).max(0.0))
+                exponentials.map(|exponential| (exponential - GAUSSIAN_AT_RADIUS).max(0.0))
             }
         }
     }
@@ -80,8 +78,9 @@ impl ReconstructionFilter {
 #[derive(Clone, Debug)]
 pub struct Film {
     rect: PixelRect,
-    sums: Vec<[f64; 3]>,
-    weights: Vec<f64>,
+    /// Each pixel's sums of weighted red, green and blue, then its sum of weights: four
+    /// numbers that one vector instruction adds to.
+    sums: Vec<[f64; 4]>,
 }
 
 impl Film {
@@ -94,8 +93,7 @@ impl Film {
     pub fn covering(rect: PixelRect) -> Self {
         Film {
             rect,
-            sums: vec![[0.0; 3]; rect.area()],
-            weights: vec![0.0; rect.area()],
+            sums: vec![[0.0; 4]; rect.area()],
         }
     }
 
@@ -113,10 +111,11 @@ impl Film {
     /// of the image (which must be covered).
     pub fn add_weighted(&mut self, x: usize, y: usize, value: [f32; 3], weight: f64) {
         let index = (y - self.rect.y0) * self.rect.width() + (x - self.rect.x0);
-        for (sum, v) in self.sums[index].iter_mut().zip(value) {
+        let [r, g, b] = value;
+        // The weight's own sum adds 1 × weight, which is the weight to the bit.
+        for (sum, v) in self.sums[index].iter_mut().zip([r, g, b, 1.0]) {
             *sum += v as f64 * weight;
         }
-        self.weights[index] += weight;
     }
 
     /// Adds a sample at image position `position` (pixels; pixel (x, y) spans [x, x + 1) ×
@@ -161,7 +160,6 @@ impl Film {
             for (sum, add) in self.sums[to].iter_mut().zip(other.sums[from]) {
                 *sum += add;
             }
-            self.weights[to] += other.weights[from];
         }
     }
 
@@ -172,11 +170,11 @@ impl Film {
             .pixels()
             .map(|(x, y)| {
                 let index = (y - self.rect.y0) * self.rect.width() + (x - self.rect.x0);
-                let weight = self.weights[index];
+                let [r, g, b, weight] = self.sums[index];
                 if weight == 0.0 {
                     [0.0; 3]
                 } else {
-                    self.sums[index].map(|s| (s / weight) as f32)
+                    [r, g, b].map(|s| (s / weight) as f32)
                 }
             })
             .collect();
@@ -192,6 +190,10 @@ impl Film {
         self.image_of(self.rect)
     }
 }
+
+/// A Gaussian's value at its radius, exp(−r² / 2σ²) with r = 4σ: exp(−8) whatever σ (the
+/// f32 nearest it, which [`fast_exp::exp`] gives too).
+const GAUSSIAN_AT_RADIUS: f32 = 3.354_626_2e-4;
 
 /// The widest margin of a filter whose weights along an axis fit [`NARROW_REACH`] lanes
 /// (radius at most 3.5 pixels: at most 8 pixel centres within it).
@@ -243,6 +245,8 @@ mod tests {
         assert_eq!(filter.margin(), 2);
         // exp(−2x²) − exp(−8): Mitsuba's windowed Gaussian at σ = ½.
         let bias = (-8.0f32).exp();
+        assert_eq!(GAUSSIAN_AT_RADIUS, bias);
+        assert_eq!(GAUSSIAN_AT_RADIUS, fast_exp::exp(-8.0));
         assert!((filter.eval(0.0) - (1.0 - bias)).abs() < 1e-7);
         assert!((filter.eval(1.0) - ((-2.0f32).exp() - bias)).abs() < 1e-7);
         assert_eq!(filter.eval(2.0), 0.0);
@@ -276,11 +280,12 @@ mod tests {
         let filter = ReconstructionFilter::Tent { radius: 16.0 };
         let mut film = Film::new(40, 1);
         film.splat(&filter, [20.3, 0.5], [1.0; 3]);
-        let reached = film.weights.iter().filter(|&&w| w > 0.0).count();
+        let weights: Vec<f64> = film.sums.iter().map(|sums| sums[3]).collect();
+        let reached = weights.iter().filter(|&&w| w > 0.0).count();
         // The centres 4.5 … 35.5 lie within 16 of 20.3.
-        assert_eq!(reached, 32, "{:?}", film.weights);
-        assert!(film.weights[4] > 0.0 && film.weights[35] > 0.0);
-        assert!(film.weights[3] == 0.0 && film.weights[36] == 0.0);
+        assert_eq!(reached, 32, "{weights:?}");
+        assert!(weights[4] > 0.0 && weights[35] > 0.0);
+        assert!(weights[3] == 0.0 && weights[36] == 0.0);
     }
 
     #[test]
