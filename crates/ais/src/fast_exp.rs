@@ -1,6 +1,6 @@
-//! The exponential in f32, within about one f32 ulp and without a call into libm, so that a loop
-//! of them runs in vector lanes: what a film's Gaussian weights need for every camera
-//! sample (Mitsuba's own filter takes its exponential from a polynomial too).
+//! The exponential in f32, within about one f32 ulp and without a call into libm, so that
+//! a loop of them runs in vector lanes: what a film's Gaussian weights need for every
+//! camera sample (Mitsuba's own filter takes its exponential from a polynomial too).
 //!
 //! exp(x) = 2ⁿ · exp(r), with n the integer nearest x / ln 2 and r = x − n ln 2 in
 //! [−ln 2 / 2, ln 2 / 2] (ln 2 split in two parts, with fused multiply-adds); exp(r) is
@@ -8,8 +8,8 @@
 //! into the exponent's bits. The unit test bounds the relative error against f64 libm by
 //! 1.2e-7 over the whole range where exp(x) is a normal f32.
 
-/// ln 2 in two parts: the f32 nearest it (so that n · this part is exact for |n| < 2⁸),
-/// and what that leaves out.
+/// ln 2 in two parts: a value near it with few bits of mantissa (so that n times it is
+/// exact for the n that occur, |n| ≤ 128), and what that leaves out.
 const LN2_HIGH: f32 = 0.693_359_4;
 const LN2_LOW: f32 = -2.121_944_4e-4;
 /// Coefficients of P, highest degree first: exp(r) ≈ 1 + r + r² · P(r).
