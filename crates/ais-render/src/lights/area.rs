@@ -339,14 +339,14 @@ impl AreaLight {
         let point = receiver.point;
         match &self.shape {
             AreaShape::Rectangle(rectangle) => {
-                let Some(view) = receiver.with_rectangle_view(rectangle, |view| *view) else {
-                    return;
-                };
-                Rectangle::sample_view_run(&view, squares, |k, direction, pdf, distance| {
-                    put(
-                        k,
-                        &AreaSample::on_rectangle(rectangle, direction, pdf, distance),
-                    )
+                // The draws made where the view is held, not from a copy of it.
+                receiver.with_rectangle_view(rectangle, |view| {
+                    Rectangle::sample_view_run(view, squares, |k, direction, pdf, distance| {
+                        put(
+                            k,
+                            &AreaSample::on_rectangle(rectangle, direction, pdf, distance),
+                        )
+                    })
                 });
             }
             AreaShape::Sphere { sphere, flipped } => {
