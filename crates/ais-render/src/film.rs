@@ -121,8 +121,8 @@ impl Film {
     /// Adds a sample at image position `position` (pixels; pixel (x, y) spans [x, x + 1) ×
     /// [y, y + 1)) to the covered pixels within `filter`'s reach.
     pub fn splat(&mut self, filter: &ReconstructionFilter, position: [f32; 2], value: [f32; 3]) {
-        // Mitsuba's default filter reaches at most 4 pixels along an axis: its weights fit
-        // one run of vector lanes, held in registers.
+        // Mitsuba's default filter reaches at most 5 pixel centres along an axis (4 but for
+        // a sample exactly half-way): its weights fit one run of vector lanes, in registers.
         match filter.margin() <= NARROW_MARGIN {
             true => self.splat_within::<NARROW_REACH>(filter, position, value),
             false => self.splat_within::<MOST_REACHED>(filter, position, value),
