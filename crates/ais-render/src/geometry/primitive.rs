@@ -132,11 +132,7 @@ impl Sphere {
     /// The nearest hit distance within the ray, if any (the far hit when starting inside).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
-        // Solve in a numerically careful form: project the centre onto the ray first.
-        let to_center = self.center - ray.origin;
-        let along = to_center.dot(ray.direction);
-        let closest = to_center - along * ray.direction;
-        let discriminant = self.radius * self.radius - closest.length_squared();
+        let (along, discriminant) = self.chord(ray.origin, ray.direction);
         if discriminant < 0.0 {
             return None;
         }
@@ -150,6 +146,25 @@ impl Sphere {
         } else {
             None
         }
+    }
+
+    /// Which of the lines from `origin` along `directions` miss the sphere: those whose
+    /// [`Sphere::intersect`] stops at its first test, worked out by the same steps over
+    /// all the lanes at once.
+    #[inline(always)]
+    pub fn missed_along<const N: usize>(&self, origin: Vec3, directions: &[Vec3; N]) -> [bool; N] {
+        std::array::from_fn(|k| self.chord(origin, directions[k]).1 < 0.0)
+    }
+
+    /// How far along the line from `origin` along `direction` the point nearest the centre
+    /// lies, and the square of half the chord the line cuts (negative: it misses). The
+    /// centre is projected onto the line first, a numerically careful form.
+    #[inline(always)]
+    fn chord(&self, origin: Vec3, direction: Vec3) -> (f32, f32) {
+        let to_center = self.center - origin;
+        let along = to_center.dot(direction);
+        let closest = to_center - along * direction;
+        (along, self.radius * self.radius - closest.length_squared())
     }
 }
 

@@ -377,6 +377,14 @@ impl AreaLight {
         }
     }
 
+    /// The light's sphere, if it is one.
+    pub(super) fn sphere(&self) -> Option<&Sphere> {
+        match &self.shape {
+            AreaShape::Sphere { sphere, .. } => Some(sphere),
+            _ => None,
+        }
+    }
+
     /// Light sampling's density (solid angle, this light alone) of drawing the point where a
     /// ray from `receiver` along `direction` first meets the light, at `distance` with
     /// geometric normal `normal`.

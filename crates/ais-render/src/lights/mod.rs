@@ -59,6 +59,9 @@ pub struct Lights {
     /// Whether there are area lights and all are rectangles: a run's directions are then
     /// resolved together ([`Lights::resolve_run`]).
     only_rectangles: bool,
+    /// Whether there are area lights and all are spheres: a run's directions that miss
+    /// them all are then found over lanes ([`Lights::sources_along`]).
+    only_spheres: bool,
     /// Per area light, whether a shaft can bound its rays ([`Lights::shaft_toward`]).
     bounded_by_shafts: Vec<bool>,
     /// Whether some shadow rays are bounded by no shaft ([`Lights::some_rays_unbounded`]).
@@ -169,6 +172,7 @@ impl Lights {
             area.iter().map(|l| shaft_outline(l).is_some()).collect();
         Lights {
             only_rectangles: !area.is_empty() && area.iter().all(|l| l.rectangle().is_some()),
+            only_spheres: !area.is_empty() && area.iter().all(|l| l.sphere().is_some()),
             some_unbounded: environment.is_some()
                 || !delta.is_empty()
                 || bounded_by_shafts.iter().any(|&bounded| !bounded),

@@ -2,11 +2,12 @@
 //! emitters: the nearest area light along it, else the environment. One direction at a
 //! time, or, where the area lights are rectangles, a run's directions together, each
 //! light tested against all of them over vector lanes ([`super::Rectangle::distances_along`]);
-//! both find the same sources, to the bit.
+//! where they are spheres, the directions that miss them all found over lanes
+//! ([`crate::geometry::Sphere::missed_along`]). Every way finds the same sources, to the bit.
 
 use super::spherical_rectangle::LANES;
 use super::toward::{AreaPoint, Source};
-use super::{AreaHit, LightSpot, Lights, Receiver, Toward};
+use super::{AreaHit, AreaLight, LightSpot, Lights, Receiver, Toward};
 use crate::geometry::Ray;
 use glam::Vec3;
 
@@ -35,10 +36,11 @@ impl Lights {
 
     /// Finds what each candidate of `drawn` (empty slots passed over) meets first among the
     /// emitters, where not known yet, as resolving them one by one would, when the
-    /// area lights are all rectangles (else each is left to be resolved when first
-    /// needed: a sphere's or a mesh's test gains nothing from lanes).
+    /// area lights are all rectangles; when they are all spheres, only for the directions
+    /// that miss them all. The others are left to be resolved when first needed (a mesh's
+    /// test gains nothing from lanes).
     pub fn resolve_run(&self, receiver: &Receiver, drawn: &mut [Option<Toward>]) {
-        if !self.only_rectangles {
+        if !(self.only_rectangles || self.only_spheres) {
             return;
         }
         for run in drawn.chunks_mut(LANES) {
@@ -53,12 +55,20 @@ impl Lights {
                     (directions[k], unknown[k]) = (toward.direction, true);
                 }
             }
-            self.rectangles_along(receiver, &directions, &unknown, |k, source| {
+            let mut put = |k: usize, source| {
                 run[k]
                     .as_mut()
                     .expect("an unknown direction is drawn")
                     .source = source;
-            });
+            };
+            if self.only_rectangles {
+                self.rectangles_along(receiver, &directions, &unknown, put);
+                continue;
+            }
+            let missed = self.all_spheres_missed(receiver.point, &directions);
+            for k in (0..LANES).filter(|&k| unknown[k] && missed[k]) {
+                put(k, self.source_at(receiver, directions[k], None));
+            }
         }
     }
 
@@ -75,9 +85,30 @@ impl Lights {
         if self.only_rectangles {
             return self.rectangles_along(receiver, directions, wanted, put);
         }
+        let missed = self.all_spheres_missed(receiver.point, directions);
         for k in (0..LANES).filter(|&k| wanted[k]) {
-            put(k, self.source_along(receiver, directions[k]));
+            put(
+                k,
+                match missed[k] {
+                    true => self.source_at(receiver, directions[k], None),
+                    false => self.source_along(receiver, directions[k]),
+                },
+            );
         }
+    }
+
+    /// Which of `directions` from `origin` surely meet no area light: where the lights are
+    /// all spheres, the lanes that miss every one by the first test of its intersection
+    /// (so that testing them one by one finds nothing either); else none.
+    fn all_spheres_missed(&self, origin: Vec3, directions: &[Vec3; LANES]) -> [bool; LANES] {
+        let mut missed = [self.only_spheres; LANES];
+        if self.only_spheres {
+            for sphere in self.area.iter().filter_map(AreaLight::sphere) {
+                let these = sphere.missed_along(origin, directions);
+                missed = std::array::from_fn(|k| missed[k] & these[k]);
+            }
+        }
+        missed
     }
 
     /// [`Lights::sources_along`] where the area lights are all rectangles.
@@ -211,6 +242,81 @@ mod tests {
         assert!(
             met.iter().all(|&m| m > 100),
             "every light and none are met: {met:?}"
+        );
+    }
+
+    /// Where the area lights are all spheres, a run's directions that miss them all are
+    /// found together, the others left, and each meets what it meets resolved alone, to
+    /// the bit, also found lane by lane ([`Lights::sources_along`]): directions drawn over
+    /// the whole sphere, and directions that graze a sphere's rim from either side.
+    #[test]
+    fn a_run_among_spheres_meets_what_each_meets_alone() {
+        let sphere = |center: Vec3, radius: f32, shape_index: u32| AreaLight {
+            shape: AreaShape::Sphere {
+                sphere: crate::geometry::Sphere { center, radius },
+                flipped: false,
+            },
+            radiance: Vec3::splat(1.0 + shape_index as f32),
+            texture: None,
+            shape_index,
+        };
+        let lights = Lights::new(
+            Emitters {
+                area: vec![
+                    sphere(Vec3::new(0.0, 0.0, 2.0), 0.5, 0),
+                    sphere(Vec3::new(3.0, 1.0, 0.0), 1.0, 1),
+                ],
+                ..Default::default()
+            },
+            2,
+            10.0,
+        );
+        let receiver = Receiver::new(Vec3::new(0.1, 0.05, 0.0));
+        let mut rng = Pcg32::new(5, 2);
+        let grazing = |light: &AreaLight, rng: &mut Pcg32| {
+            let sphere = light.sphere().expect("a sphere");
+            let to_center = sphere.center - receiver.point;
+            let rim = (sphere.radius / to_center.length()).asin();
+            let angle = rim * (1.0 + 2e-4 * (2.0 * rng.next_f32() - 1.0));
+            let toward = to_center.normalize();
+            let across = glam::Quat::from_axis_angle(toward, 6.3 * rng.next_f32())
+                * toward.any_orthonormal_vector();
+            (toward * angle.cos() + across * angle.sin()).normalize()
+        };
+        let (mut found_together, mut left, mut met) = (0, 0, [0; 3]);
+        for round in 0..300 {
+            let directions: [Vec3; LANES] = std::array::from_fn(|k| match k % 4 {
+                0 => grazing(&lights.area[round % 2], &mut rng),
+                _ => uniform_sphere([rng.next_f32(), rng.next_f32()]),
+            });
+            let mut drawn: Vec<Option<Toward>> =
+                directions.iter().map(|&d| Some(Toward::new(d))).collect();
+            lights.resolve_run(&receiver, &mut drawn);
+            let wanted = [true; LANES];
+            let mut along = [Source::Unknown; LANES];
+            lights.sources_along(&receiver, &directions, &wanted, |k, s| along[k] = s);
+            for (k, together) in drawn.iter_mut().flatten().enumerate() {
+                match together.source {
+                    Source::Unknown => left += 1,
+                    _ => found_together += 1,
+                }
+                lights.resolve(&receiver, together);
+                let alone = lights.source_along(&receiver, directions[k]);
+                assert_eq!(format!("{:?}", together.source), format!("{alone:?}"));
+                assert_eq!(format!("{:?}", along[k]), format!("{alone:?}"));
+                met[match alone {
+                    Source::Area(point) => point.light,
+                    _ => 2,
+                }] += 1;
+            }
+        }
+        assert!(
+            found_together > 1000 && left > 500,
+            "misses found together: {found_together}, others left: {left}"
+        );
+        assert!(
+            met.iter().all(|&m| m > 200),
+            "each sphere and none: {met:?}"
         );
     }
 }
