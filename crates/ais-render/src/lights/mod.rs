@@ -313,7 +313,9 @@ impl Lights {
 
     /// [`Lights::sample_toward`], except that a draw from the environment or an area light is
     /// left to be made together with other candidates' ([`EnvironmentDraws`], [`AreaDraws`]).
-    #[inline]
+    /// (Inlined into every caller: a call returned the draw through memory, written a field
+    /// at a time and read back whole, and the reads waited for the writes.)
+    #[inline(always)]
     pub fn begin_sample(&self, receiver: &Receiver, u: [f32; 2]) -> Draw {
         let Some(choice) = self.choice_for(receiver) else {
             return Draw::Made(None);

@@ -126,11 +126,14 @@ struct Lanes {
     /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
     specular: [Option<SpecularMass>; RUN],
     /// Whether its shadow ray is left to the pixel's pool to trace (then `free` holds until
-    /// the pool finds otherwise), and the point the ray ends at, if it ends. Both are set
-    /// only for candidates whose ray is needed, and read only where `free` is set: a lane
-    /// whose ray is not needed may hold an earlier run's.
+    /// the pool finds otherwise), whether the ray ends, and the point it ends at. `deferred`
+    /// is set only for candidates whose ray is needed, and read only where `free` is set: a
+    /// lane whose ray is not needed may hold an earlier run's; the others, only where
+    /// `deferred` is. (Two arrays, not one of `Option<Vec3>`: an option written a field at
+    /// a time and copied whole waits for the stores to complete.)
     deferred: [bool; RUN],
-    target: [Option<Vec3>; RUN],
+    bounded: [bool; RUN],
+    target: [Vec3; RUN],
 }
 
 impl Default for Lanes {
@@ -146,12 +149,19 @@ impl Default for Lanes {
             free: [false; RUN],
             specular: [None; RUN],
             deferred: [false; RUN],
-            target: [None; RUN],
+            bounded: [false; RUN],
+            target: [Vec3::ZERO; RUN],
         }
     }
 }
 
 impl Lanes {
+    /// The point candidate `k`'s shadow ray ends at, if it ends (set where it is deferred).
+    #[inline]
+    fn target_of(&self, k: usize) -> Option<Vec3> {
+        self.bounded[k].then_some(self.target[k])
+    }
+
     /// Candidate `k` drawn toward `toward`, which meets `source` first (kept only where
     /// the lanes keep sources, `SOURCES`).
     #[inline]
@@ -246,7 +256,7 @@ impl<'a> PlainLanes<'a> {
                     match (lanes.free[k], DEFERS && lanes.deferred[k], run.pixel_pool) {
                         (false, ..) => Vec3::ZERO,
                         (true, true, Some(pool)) => {
-                            let ray = shadow_ray(run.at, lanes.direction[k], lanes.target[k]);
+                            let ray = shadow_ray(run.at, lanes.direction[k], lanes.target_of(k));
                             let brings = self.brings::<SOURCES>(run, &lanes, k);
                             pool.borrow_mut().leave(ray, brings, 1.0 / run.rays as f32);
                             Vec3::ZERO
@@ -463,26 +473,33 @@ fn trace<const SOURCES: bool, const DEFERS: bool>(
             false => Aim::Unbounded,
         };
         let target = match aim {
-            Aim::Nothing => None,
-            Aim::Point(target) => Some(Some(target)),
-            Aim::Unbounded => Some(None),
-        };
-        lanes.free[k] = target.is_some_and(|target| {
-            counts.occlusion += 1;
-            // A ray toward a light with a shaft stays with the gather, which may find it
-            // free from the shaft (leaving those to the pool too lost time in a room lit
-            // through a door gap).
-            let light = shaft_light(&lanes.source[k]);
-            if DEFERS {
-                lanes.deferred[k] = light.is_none();
-                lanes.target[k] = target;
-                if light.is_none() {
-                    return true;
-                }
+            Aim::Nothing => {
+                lanes.free[k] = false;
+                continue;
             }
-            let ray = shadow_ray(at, lanes.direction[k], target);
-            !origin.occluded_aiming(world, at, light, &ray)
-        });
+            Aim::Point(target) => {
+                (lanes.bounded[k], lanes.target[k]) = (true, target);
+                Some(target)
+            }
+            Aim::Unbounded => {
+                lanes.bounded[k] = false;
+                None
+            }
+        };
+        counts.occlusion += 1;
+        // A ray toward a light with a shaft stays with the gather, which may find it free
+        // from the shaft (leaving those to the pool too lost time in a room lit through a
+        // door gap).
+        let light = shaft_light(&lanes.source[k]);
+        if DEFERS {
+            lanes.deferred[k] = light.is_none();
+            if light.is_none() {
+                lanes.free[k] = true;
+                continue;
+            }
+        }
+        let ray = shadow_ray(at, lanes.direction[k], target);
+        lanes.free[k] = !origin.occluded_aiming(world, at, light, &ray);
     }
 }
 
