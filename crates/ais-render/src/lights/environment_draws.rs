@@ -47,8 +47,10 @@ impl Step {
         Step::Row { row, fy, u }
     }
 
-    /// The second step: the cell within the row or the texel.
-    #[inline]
+    /// The second step: the cell within the row or the texel. (Inlined: returned from a
+    /// call, the step went through memory a field at a time and was read back whole, and
+    /// the read waited for the writes.)
+    #[inline(always)]
     fn second(self, map: &EnvironmentMap, guide: Option<&EnvironmentGuide>) -> Step {
         match self {
             Step::Row { row, fy, u } => {

@@ -67,7 +67,7 @@ impl Lights {
             }
             let missed = self.all_spheres_missed(receiver.point, &directions);
             for k in (0..LANES).filter(|&k| unknown[k] && missed[k]) {
-                put(k, self.source_at(receiver, directions[k], None));
+                put(k, self.past_area_lights());
             }
         }
     }
@@ -90,7 +90,7 @@ impl Lights {
             put(
                 k,
                 match missed[k] {
-                    true => self.source_at(receiver, directions[k], None),
+                    true => self.past_area_lights(),
                     false => self.source_along(receiver, directions[k]),
                 },
             );
@@ -168,7 +168,16 @@ impl Lights {
                     region,
                 })
             }
-            None if self.environment.is_some() => Source::Environment,
+            None => self.past_area_lights(),
+        }
+    }
+
+    /// What a direction that meets no area light meets: the environment, or nothing.
+    /// (Inlined: returned from a call, the source's copy waits for the write of its tag.)
+    #[inline(always)]
+    fn past_area_lights(&self) -> Source {
+        match self.environment {
+            Some(_) => Source::Environment,
             None => Source::Dark,
         }
     }
