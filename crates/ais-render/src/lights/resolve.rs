@@ -18,12 +18,13 @@ impl Lights {
     /// Finds what `toward` meets first among the emitters, if not known yet.
     pub(super) fn resolve(&self, receiver: &Receiver, toward: &mut Toward) {
         if matches!(toward.source, Source::Unknown) {
-            toward.source = self.source_along(receiver, toward.direction);
+            self.write_source_along(receiver, toward.direction, &mut toward.source);
         }
     }
 
-    /// What `direction` from `receiver` meets first among the emitters.
-    pub(crate) fn source_along(&self, receiver: &Receiver, direction: Vec3) -> Source {
+    /// Writes to `out` what `direction` from `receiver` meets first among the emitters
+    /// (in place: see [`Lights::write_source_at`]).
+    fn write_source_along(&self, receiver: &Receiver, direction: Vec3, out: &mut Source) {
         let ray = Ray::new(receiver.point, direction);
         let nearest = self
             .area
@@ -31,7 +32,7 @@ impl Lights {
             .enumerate()
             .filter_map(|(index, light)| light.intersect(&ray).map(|hit| (hit, index)))
             .min_by(|a, b| a.0.distance.total_cmp(&b.0.distance));
-        self.source_at(receiver, direction, nearest)
+        self.write_source_at(receiver, direction, nearest, out);
     }
 
     /// Finds what each candidate of `drawn` (empty slots passed over) meets first among the
@@ -55,45 +56,47 @@ impl Lights {
                     (directions[k], unknown[k]) = (toward.direction, true);
                 }
             }
-            let mut put = |k: usize, source| {
-                run[k]
-                    .as_mut()
-                    .expect("an unknown direction is drawn")
-                    .source = source;
-            };
-            if self.only_rectangles {
-                self.rectangles_along(receiver, &directions, &unknown, put);
-                continue;
+            let mut sources = [Source::Unknown; LANES];
+            match self.only_rectangles {
+                true => self.rectangles_along(receiver, &directions, &unknown, &mut sources),
+                false => {
+                    let missed = self.all_spheres_missed(receiver.point, &directions);
+                    for k in (0..LANES).filter(|&k| unknown[k] && missed[k]) {
+                        sources[k] = self.past_area_lights();
+                    }
+                }
             }
-            let missed = self.all_spheres_missed(receiver.point, &directions);
-            for k in (0..LANES).filter(|&k| unknown[k] && missed[k]) {
-                put(k, self.past_area_lights());
+            for (toward, source) in run.iter_mut().zip(sources) {
+                if let Some(toward) = toward
+                    .as_mut()
+                    .filter(|_| !matches!(source, Source::Unknown))
+                {
+                    toward.source = source;
+                }
             }
         }
     }
 
     /// What each of `directions` from `receiver` whose lane is set in `wanted` meets first
-    /// among the emitters, given to `put` with its lane: the sources [`Lights::source_along`]
-    /// finds one by one, rectangles tested against all the lanes at once.
+    /// among the emitters, written to its lane of `sources`: the sources
+    /// [`Lights::write_source_along`] finds one by one, rectangles tested against all the lanes
+    /// at once.
     pub(crate) fn sources_along(
         &self,
         receiver: &Receiver,
         directions: &[Vec3; LANES],
         wanted: &[bool; LANES],
-        mut put: impl FnMut(usize, Source),
+        sources: &mut [Source; LANES],
     ) {
         if self.only_rectangles {
-            return self.rectangles_along(receiver, directions, wanted, put);
+            return self.rectangles_along(receiver, directions, wanted, sources);
         }
         let missed = self.all_spheres_missed(receiver.point, directions);
         for k in (0..LANES).filter(|&k| wanted[k]) {
-            put(
-                k,
-                match missed[k] {
-                    true => self.past_area_lights(),
-                    false => self.source_along(receiver, directions[k]),
-                },
-            );
+            match missed[k] {
+                true => sources[k] = self.past_area_lights(),
+                false => self.write_source_along(receiver, directions[k], &mut sources[k]),
+            }
         }
     }
 
@@ -117,14 +120,14 @@ impl Lights {
         receiver: &Receiver,
         directions: &[Vec3; LANES],
         wanted: &[bool; LANES],
-        mut put: impl FnMut(usize, Source),
+        sources: &mut [Source; LANES],
     ) {
         if !wanted.contains(&true) {
             return;
         }
         let nearest = self.nearest_rectangles(receiver.point, directions);
         for k in (0..LANES).filter(|&k| wanted[k]) {
-            put(k, self.source_at(receiver, directions[k], nearest[k]));
+            self.write_source_at(receiver, directions[k], nearest[k], &mut sources[k]);
         }
     }
 
@@ -152,9 +155,18 @@ impl Lights {
         nearest
     }
 
-    /// The source of `direction` from `receiver` whose nearest area light is `nearest`.
-    fn source_at(&self, receiver: &Receiver, direction: Vec3, nearest: Nearest) -> Source {
-        match nearest {
+    /// Writes to `out` the source of `direction` from `receiver` whose nearest area light
+    /// is `nearest`. (Written in place, a candidate's source is not copied: returned from a
+    /// call, it was written a field at a time and copied whole, and the copy waited for the
+    /// writes.)
+    fn write_source_at(
+        &self,
+        receiver: &Receiver,
+        direction: Vec3,
+        nearest: Nearest,
+        out: &mut Source,
+    ) {
+        *out = match nearest {
             Some((hit, index)) => {
                 let light = &self.area[index];
                 let density = light.density_at(receiver, direction, hit.distance, hit.normal);
@@ -169,7 +181,7 @@ impl Lights {
                 })
             }
             None => self.past_area_lights(),
-        }
+        };
     }
 
     /// What a direction that meets no area light meets: the environment, or nothing.
@@ -303,14 +315,15 @@ mod tests {
             lights.resolve_run(&receiver, &mut drawn);
             let wanted = [true; LANES];
             let mut along = [Source::Unknown; LANES];
-            lights.sources_along(&receiver, &directions, &wanted, |k, s| along[k] = s);
+            lights.sources_along(&receiver, &directions, &wanted, &mut along);
             for (k, together) in drawn.iter_mut().flatten().enumerate() {
                 match together.source {
                     Source::Unknown => left += 1,
                     _ => found_together += 1,
                 }
                 lights.resolve(&receiver, together);
-                let alone = lights.source_along(&receiver, directions[k]);
+                let mut alone = Source::Unknown;
+                lights.write_source_along(&receiver, directions[k], &mut alone);
                 assert_eq!(format!("{:?}", together.source), format!("{alone:?}"));
                 assert_eq!(format!("{:?}", along[k]), format!("{alone:?}"));
                 met[match alone {

@@ -437,10 +437,7 @@ fn meet(run: &BatchRun, lanes: &mut Lanes, count: usize) {
         k < count && lanes.kept[k] && matches!(lanes.source[k], Source::Unknown)
     });
     let receiver = &run.at.receiver;
-    let source = &mut lanes.source;
-    (run.world.lights).sources_along(receiver, &lanes.direction, &wanted, |k, met| {
-        source[k] = met
-    });
+    (run.world.lights).sources_along(receiver, &lanes.direction, &wanted, &mut lanes.source);
 }
 
 /// Traces the shadow rays of the kept candidates of `lanes` (the first `count`) that could
