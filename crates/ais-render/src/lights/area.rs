@@ -377,11 +377,27 @@ impl AreaLight {
         }
     }
 
-    /// The light's sphere, if it is one.
-    pub(super) fn sphere(&self) -> Option<&Sphere> {
+    /// Whether [`AreaLight::missed_along`] can find misses: the light is a sphere or a mesh.
+    pub(super) fn has_misses_in_lanes(&self) -> bool {
+        matches!(
+            self.shape,
+            AreaShape::Sphere { .. } | AreaShape::Triangles(_)
+        )
+    }
+
+    /// Which of the unbounded rays from `origin` along `directions` surely miss the light,
+    /// found over lanes by the first test of its own intersection ([`AreaLight::intersect`]
+    /// then finds nothing either): a sphere's chord, a mesh's ball. None for other shapes.
+    #[inline(always)]
+    pub(super) fn missed_along<const N: usize>(
+        &self,
+        origin: Vec3,
+        directions: &[Vec3; N],
+    ) -> [bool; N] {
         match &self.shape {
-            AreaShape::Sphere { sphere, .. } => Some(sphere),
-            _ => None,
+            AreaShape::Sphere { sphere, .. } => sphere.missed_along(origin, directions),
+            AreaShape::Triangles(mesh) => mesh.missed_along(origin, directions),
+            _ => [false; N],
         }
     }
 

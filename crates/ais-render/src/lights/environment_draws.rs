@@ -104,15 +104,15 @@ impl EnvironmentDraws {
         let guide = receiver.environment_guide;
         let map = match &lights.environment {
             Some(Environment::Map(map)) if guide.is_none_or(|g| g.partition().holds_cells()) => map,
-            _ => {
-                // Nothing to overlap: one draw at a time.
+            Some(environment) => {
+                // Nothing to overlap: one draw at a time. (Given as it is drawn: wrapped in
+                // an option, it was copied whole before its fields were all written.)
                 for (&slot, &u) in slots.iter().zip(numbers.iter()) {
-                    if let Some(toward) = lights.environment_toward(receiver, u) {
-                        put(slot, toward);
-                    }
+                    put(slot, receiver.sample_environment(environment, u));
                 }
                 return;
             }
+            None => return,
         };
         let mut steps = [Step::Row {
             row: 0,

@@ -198,6 +198,17 @@ impl MeshEmitter {
         density
     }
 
+    /// Which of the unbounded rays from `origin` along `directions` surely meet no
+    /// triangle: those that [`MeshEmitter::intersect`] turns away at its first test (the
+    /// ball around the mesh), worked out by the same steps over all the lanes at once.
+    #[inline(always)]
+    pub fn missed_along<const N: usize>(&self, origin: Vec3, directions: &[Vec3; N]) -> [bool; N] {
+        std::array::from_fn(|k| {
+            self.bounds
+                .missed_from(origin, directions[k], f32::INFINITY)
+        })
+    }
+
     /// The nearest point of the mesh along `ray` (within `ray.t_max`).
     pub fn intersect(&self, ray: &Ray) -> Option<AreaHit> {
         if self.bounds.missed_by(ray) {
@@ -254,12 +265,19 @@ impl Ball {
     /// difference of squares, which cancels for origins far from the ball.
     #[inline]
     fn missed_by(&self, ray: &Ray) -> bool {
-        let to_centre = self.centre - ray.origin;
-        let along = to_centre.dot(ray.direction);
-        let beside = to_centre - along * ray.direction;
-        beside.length_squared() > self.radius * self.radius
-            || along < -self.radius
-            || along - self.radius > ray.t_max
+        self.missed_from(ray.origin, ray.direction, ray.t_max)
+    }
+
+    /// [`Ball::missed_by`] for the ray from `origin` along `direction` up to `t_max`.
+    #[inline(always)]
+    fn missed_from(&self, origin: Vec3, direction: Vec3, t_max: f32) -> bool {
+        let to_centre = self.centre - origin;
+        let along = to_centre.dot(direction);
+        let beside = to_centre - along * direction;
+        // `|`, not `||`: no branch, so that a run of them can go over vector lanes.
+        (beside.length_squared() > self.radius * self.radius)
+            | (along < -self.radius)
+            | (along - self.radius > t_max)
     }
 }
 

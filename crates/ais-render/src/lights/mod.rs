@@ -59,9 +59,9 @@ pub struct Lights {
     /// Whether there are area lights and all are rectangles: a run's directions are then
     /// resolved together ([`Lights::resolve_run`]).
     only_rectangles: bool,
-    /// Whether there are area lights and all are spheres: a run's directions that miss
-    /// them all are then found over lanes ([`Lights::sources_along`]).
-    only_spheres: bool,
+    /// Whether there are area lights and all are spheres or meshes: a run's directions
+    /// that miss them all are then found over lanes ([`Lights::sources_along`]).
+    misses_in_lanes: bool,
     /// Per area light, whether a shaft can bound its rays ([`Lights::shaft_toward`]).
     bounded_by_shafts: Vec<bool>,
     /// Whether some shadow rays are bounded by no shaft ([`Lights::some_rays_unbounded`]).
@@ -172,7 +172,7 @@ impl Lights {
             area.iter().map(|l| shaft_outline(l).is_some()).collect();
         Lights {
             only_rectangles: !area.is_empty() && area.iter().all(|l| l.rectangle().is_some()),
-            only_spheres: !area.is_empty() && area.iter().all(|l| l.sphere().is_some()),
+            misses_in_lanes: !area.is_empty() && area.iter().all(AreaLight::has_misses_in_lanes),
             some_unbounded: environment.is_some()
                 || !delta.is_empty()
                 || bounded_by_shafts.iter().any(|&bounded| !bounded),
@@ -380,11 +380,7 @@ impl Lights {
     /// The environment's direction from `u` (drawn by the receiver's guide when it has one).
     #[inline]
     fn environment_toward(&self, receiver: &Receiver, u: [f32; 2]) -> Option<Toward> {
-        let environment = self.environment.as_ref()?;
-        Some(match receiver.environment_guide {
-            Some(guide) => guide.sample(environment, u),
-            None => environment.sample_toward(u),
-        })
+        Some(receiver.sample_environment(self.environment.as_ref()?, u))
     }
 
     /// [`Lights::sample_direction`] with its density over directions.

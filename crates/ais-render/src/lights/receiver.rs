@@ -7,7 +7,7 @@
 //! over a hundred bytes, so candidates read it in place rather than copy it.
 
 use super::spherical_rectangle::{Rectangle, View};
-use super::{EnvironmentGuide, RegionChoice};
+use super::{Environment, EnvironmentGuide, RegionChoice, Toward};
 use ais::sampling::AliasTable;
 use glam::Vec3;
 use std::cell::RefCell;
@@ -56,6 +56,16 @@ impl<'a> Receiver<'a> {
         Receiver {
             environment_guide: Some(guide),
             ..Receiver::new(point)
+        }
+    }
+
+    /// A direction drawn from `u` from `environment`, by this receiver's guide when it has
+    /// one.
+    #[inline(always)]
+    pub fn sample_environment(&self, environment: &Environment, u: [f32; 2]) -> Toward {
+        match self.environment_guide {
+            Some(guide) => guide.sample(environment, u),
+            None => environment.sample_toward(u),
         }
     }
 

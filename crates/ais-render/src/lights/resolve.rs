@@ -2,12 +2,12 @@
 //! emitters: the nearest area light along it, else the environment. One direction at a
 //! time, or, where the area lights are rectangles, a run's directions together, each
 //! light tested against all of them over vector lanes ([`super::Rectangle::distances_along`]);
-//! where they are spheres, the directions that miss them all found over lanes
-//! ([`crate::geometry::Sphere::missed_along`]). Every way finds the same sources, to the bit.
+//! where they are spheres and meshes, the directions that miss them all found over lanes
+//! ([`super::AreaLight::missed_along`]). Every way finds the same sources, to the bit.
 
 use super::spherical_rectangle::LANES;
 use super::toward::{AreaPoint, Source};
-use super::{AreaHit, AreaLight, LightSpot, Lights, Receiver, Toward};
+use super::{AreaHit, LightSpot, Lights, Receiver, Toward};
 use crate::geometry::Ray;
 use glam::Vec3;
 
@@ -36,12 +36,11 @@ impl Lights {
     }
 
     /// Finds what each candidate of `drawn` (empty slots passed over) meets first among the
-    /// emitters, where not known yet, as resolving them one by one would, when the
-    /// area lights are all rectangles; when they are all spheres, only for the directions
-    /// that miss them all. The others are left to be resolved when first needed (a mesh's
-    /// test gains nothing from lanes).
+    /// emitters, where not known yet, as resolving them one by one would, when the area
+    /// lights are all rectangles; when they are all spheres and meshes, only for the
+    /// directions that miss them all. The others are left to be resolved when first needed.
     pub fn resolve_run(&self, receiver: &Receiver, drawn: &mut [Option<Toward>]) {
-        if !(self.only_rectangles || self.only_spheres) {
+        if !(self.only_rectangles || self.misses_in_lanes) {
             return;
         }
         for run in drawn.chunks_mut(LANES) {
@@ -60,7 +59,7 @@ impl Lights {
             match self.only_rectangles {
                 true => self.rectangles_along(receiver, &directions, &unknown, &mut sources),
                 false => {
-                    let missed = self.all_spheres_missed(receiver.point, &directions);
+                    let missed = self.all_missed(receiver.point, &directions);
                     for k in (0..LANES).filter(|&k| unknown[k] && missed[k]) {
                         sources[k] = self.past_area_lights();
                     }
@@ -91,7 +90,7 @@ impl Lights {
         if self.only_rectangles {
             return self.rectangles_along(receiver, directions, wanted, sources);
         }
-        let missed = self.all_spheres_missed(receiver.point, directions);
+        let missed = self.all_missed(receiver.point, directions);
         for k in (0..LANES).filter(|&k| wanted[k]) {
             match missed[k] {
                 true => sources[k] = self.past_area_lights(),
@@ -101,13 +100,13 @@ impl Lights {
     }
 
     /// Which of `directions` from `origin` surely meet no area light: where the lights are
-    /// all spheres, the lanes that miss every one by the first test of its intersection
-    /// (so that testing them one by one finds nothing either); else none.
-    fn all_spheres_missed(&self, origin: Vec3, directions: &[Vec3; LANES]) -> [bool; LANES] {
-        let mut missed = [self.only_spheres; LANES];
-        if self.only_spheres {
-            for sphere in self.area.iter().filter_map(AreaLight::sphere) {
-                let these = sphere.missed_along(origin, directions);
+    /// all spheres and meshes, the lanes that miss every one by the first test of its
+    /// intersection (so that testing them one by one finds nothing either); else none.
+    fn all_missed(&self, origin: Vec3, directions: &[Vec3; LANES]) -> [bool; LANES] {
+        let mut missed = [self.misses_in_lanes; LANES];
+        if self.misses_in_lanes {
+            for light in &self.area {
+                let these = light.missed_along(origin, directions);
                 missed = std::array::from_fn(|k| missed[k] & these[k]);
             }
         }
@@ -198,7 +197,9 @@ impl Lights {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::lights::{AreaLight, AreaShape, Emitters, Rectangle, RegionChoice, REGIONS};
+    use crate::lights::{
+        AreaLight, AreaShape, Emitters, MeshEmitter, Rectangle, RegionChoice, REGIONS,
+    };
     use ais::rng::Pcg32;
     use ais::sampling::uniform_sphere;
 
@@ -266,12 +267,13 @@ mod tests {
         );
     }
 
-    /// Where the area lights are all spheres, a run's directions that miss them all are
-    /// found together, the others left, and each meets what it meets resolved alone, to
-    /// the bit, also found lane by lane ([`Lights::sources_along`]): directions drawn over
-    /// the whole sphere, and directions that graze a sphere's rim from either side.
+    /// Where the area lights are all spheres and meshes, a run's directions that miss them
+    /// all are found together, the others left, and each meets what it meets resolved
+    /// alone, to the bit, also found lane by lane ([`Lights::sources_along`]): directions
+    /// drawn over the whole sphere, directions that graze a sphere's rim from either side,
+    /// and directions close to a mesh's corners.
     #[test]
-    fn a_run_among_spheres_meets_what_each_meets_alone() {
+    fn a_run_among_spheres_and_meshes_meets_what_each_meets_alone() {
         let sphere = |center: Vec3, radius: f32, shape_index: u32| AreaLight {
             shape: AreaShape::Sphere {
                 sphere: crate::geometry::Sphere { center, radius },
@@ -286,16 +288,27 @@ mod tests {
                 area: vec![
                     sphere(Vec3::new(0.0, 0.0, 2.0), 0.5, 0),
                     sphere(Vec3::new(3.0, 1.0, 0.0), 1.0, 1),
+                    AreaLight {
+                        shape: AreaShape::Triangles(Box::new(MeshEmitter::new(
+                            tetrahedron(),
+                            None,
+                        ))),
+                        radiance: Vec3::ONE,
+                        texture: None,
+                        shape_index: 2,
+                    },
                 ],
                 ..Default::default()
             },
-            2,
+            3,
             10.0,
         );
         let receiver = Receiver::new(Vec3::new(0.1, 0.05, 0.0));
         let mut rng = Pcg32::new(5, 2);
         let grazing = |light: &AreaLight, rng: &mut Pcg32| {
-            let sphere = light.sphere().expect("a sphere");
+            let AreaShape::Sphere { sphere, .. } = light.shape else {
+                unreachable!("a sphere")
+            };
             let to_center = sphere.center - receiver.point;
             let rim = (sphere.radius / to_center.length()).asin();
             let angle = rim * (1.0 + 2e-4 * (2.0 * rng.next_f32() - 1.0));
@@ -304,10 +317,16 @@ mod tests {
                 * toward.any_orthonormal_vector();
             (toward * angle.cos() + across * angle.sin()).normalize()
         };
-        let (mut found_together, mut left, mut met) = (0, 0, [0; 3]);
+        let corners: Vec<Vec3> = tetrahedron().iter().map(|t| t.vertices[0]).collect();
+        let (mut found_together, mut left, mut met) = (0, 0, [0; 4]);
         for round in 0..300 {
             let directions: [Vec3; LANES] = std::array::from_fn(|k| match k % 4 {
                 0 => grazing(&lights.area[round % 2], &mut rng),
+                1 => {
+                    let corner = corners[k / 4 % corners.len()] - receiver.point;
+                    let jitter = 0.02 * (uniform_sphere([rng.next_f32(), rng.next_f32()]));
+                    (corner.normalize() + jitter).normalize()
+                }
                 _ => uniform_sphere([rng.next_f32(), rng.next_f32()]),
             });
             let mut drawn: Vec<Option<Toward>> =
@@ -328,7 +347,7 @@ mod tests {
                 assert_eq!(format!("{:?}", along[k]), format!("{alone:?}"));
                 met[match alone {
                     Source::Area(point) => point.light,
-                    _ => 2,
+                    _ => 3,
                 }] += 1;
             }
         }
@@ -338,7 +357,27 @@ mod tests {
         );
         assert!(
             met.iter().all(|&m| m > 200),
-            "each sphere and none: {met:?}"
+            "each sphere, the mesh and none: {met:?}"
         );
+    }
+
+    /// A small tetrahedron's four faces, away from the other lights.
+    fn tetrahedron() -> Vec<crate::geometry::Triangle> {
+        let corner = |x: f32, y: f32, z: f32| Vec3::new(-2.0, 0.5, -1.0) + 0.3 * Vec3::new(x, y, z);
+        let [a, b, c, d] = [
+            corner(1.0, 1.0, 1.0),
+            corner(1.0, -1.0, -1.0),
+            corner(-1.0, 1.0, -1.0),
+            corner(-1.0, -1.0, 1.0),
+        ];
+        [[a, b, c], [b, d, c], [c, d, a], [d, b, a]]
+            .into_iter()
+            .enumerate()
+            .map(|(index, vertices)| crate::geometry::Triangle {
+                vertices,
+                mesh: 0,
+                index: index as u32,
+            })
+            .collect()
     }
 }
