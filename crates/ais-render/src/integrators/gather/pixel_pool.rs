@@ -35,6 +35,8 @@ pub struct PixelPool {
     left: Vec<Left>,
     /// The candidates' order of direction, kept to spare an allocation per pixel.
     order: Vec<u32>,
+    /// Each candidate's cell of direction, found once for both passes of the sort.
+    cells: Vec<u16>,
 }
 
 /// What a candidate whose ray is left in the pool brings if the ray is free.
@@ -162,17 +164,23 @@ impl PixelPool {
     /// Puts the indices of the candidates in `order`, by direction: a counting sort over
     /// cells of the directions' octants.
     fn sort_by_direction(&mut self) {
+        self.cells.clear();
+        (self.cells).extend(
+            self.left
+                .iter()
+                .map(|l| direction_cell(l.ray.direction) as u16),
+        );
         let mut starts = [0u32; DIRECTION_CELLS + 1];
-        for left in &self.left {
-            starts[direction_cell(left.ray.direction) + 1] += 1;
+        for &cell in &self.cells {
+            starts[cell as usize + 1] += 1;
         }
         for cell in 0..DIRECTION_CELLS {
             starts[cell + 1] += starts[cell];
         }
         self.order.clear();
         self.order.resize(self.left.len(), 0);
-        for (i, left) in self.left.iter().enumerate() {
-            let start = &mut starts[direction_cell(left.ray.direction)];
+        for (i, &cell) in self.cells.iter().enumerate() {
+            let start = &mut starts[cell as usize];
             self.order[*start as usize] = i as u32;
             *start += 1;
         }
