@@ -221,7 +221,10 @@ impl Surface {
     }
 
     /// The BSDF at `point`, and the frame that stands for the surface there (for what
-    /// keys on the normal, and for offsetting rays).
+    /// keys on the normal, and for offsetting rays). (Inlined: returned from a call, the
+    /// pair went through memory a field at a time and was copied whole into the gather
+    /// point, and the copy waited for the writes.)
+    #[inline(always)]
     pub fn at(&self, point: &SurfacePoint) -> (HitBsdf<'_>, ShadingFrame) {
         if let Surface::Material { material, textures } = self {
             let material = if textures.is_empty() {

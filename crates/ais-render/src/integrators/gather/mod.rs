@@ -427,7 +427,10 @@ pub fn gather<P: BatchProbe>(
     let started =
         (field && field::times_next_gather(state, settings)).then(std::time::Instant::now);
     counts.closest_hit += 1;
-    let Some(hit) = world.geometry.intersect(ray) else {
+    // The hit read where it was returned, not moved out of its option: a move copied it
+    // whole before its fields were all written, and the copy waited for the writes.
+    let found = world.geometry.intersect(ray);
+    let Some(hit) = &found else {
         if settings.hide_emitters {
             return Vec3::ZERO;
         }
@@ -443,17 +446,17 @@ pub fn gather<P: BatchProbe>(
     if world.lights.is_empty() {
         return emitted;
     }
-    let mut at = gather_point(world, &hit, -ray.direction);
+    let mut at = gather_point(world, hit, -ray.direction);
     at.mis_bsdf_share = state.mis_share.unwrap_or(strategy::MIS_BSDF_WEIGHT);
     let footprint = world.camera.footprint(hit.t, world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if field {
-        let mut site = field::FieldSite::new(&hit, at, footprint, settings.field_cell, seed);
+        let mut site = field::FieldSite::new(hit, at, footprint, settings.field_cell, seed);
         site.started = started;
         return emitted + field::field_gather(world, settings, site, state, counts);
     }
     let site = MapSite {
-        hit: &hit,
+        hit,
         footprint,
         seed,
     };
