@@ -446,21 +446,24 @@ pub fn gather<P: BatchProbe>(
     if world.lights.is_empty() {
         return emitted;
     }
-    let mut at = gather_point(world, hit, -ray.direction);
-    at.mis_bsdf_share = state.mis_share.unwrap_or(strategy::MIS_BSDF_WEIGHT);
+    let mis_bsdf_share = state.mis_share.unwrap_or(strategy::MIS_BSDF_WEIGHT);
     let footprint = world.camera.footprint(hit.t, world.resolution.0);
     let seed = ((rng.next_u32() as u64) << 32) | rng.next_u32() as u64;
     if field {
+        let mut at = gather_point(world, hit, -ray.direction);
+        at.mis_bsdf_share = mis_bsdf_share;
         let mut site = field::FieldSite::new(hit, at, footprint, settings.field_cell, seed);
         site.started = started;
         return emitted + field::field_gather(world, settings, site, state, counts);
     }
     let site = MapSite {
         hit,
+        wo: -ray.direction,
+        mis_bsdf_share,
         footprint,
         seed,
     };
-    emitted + map_gather(world, settings, &site, at, state, counts)
+    emitted + map_gather(world, settings, &site, state, counts)
 }
 
 /// The values of a pixel's camera `rays` (its samples, in order), pushed onto `values`:
@@ -517,10 +520,16 @@ pub(super) fn note_gather_variance(
     }
 }
 
-/// Where a gather with the batch's own map (or none) happens.
+/// Where a gather with the batch's own map (or none) happens. (The gather point is made
+/// where it is used, from the hit, `wo` and the share: some thousand bytes, it was copied
+/// into the gather's call, and the copy waited for the writes of its fields.)
 struct MapSite<'a> {
     /// The first hit.
     hit: &'a Hit,
+    /// The direction toward the viewer.
+    wo: Vec3,
+    /// The BSDF's share of the MIS mixture.
+    mis_bsdf_share: f64,
     /// The pixel footprint there.
     footprint: f32,
     /// The batch's scrambling seed.
@@ -533,12 +542,11 @@ fn map_gather<P: BatchProbe>(
     world: &World,
     settings: &GatherSettings,
     site: &MapSite,
-    at: GatherPoint,
     state: &mut GatherTile<P>,
     counts: &mut RayCounts,
 ) -> Vec3 {
-    // A guided gather points `at` at a guide borrowed from `state`: a shorter lifetime.
-    let mut at: GatherPoint<'_> = at;
+    let mut at = gather_point(world, site.hit, site.wo);
+    at.mis_bsdf_share = site.mis_bsdf_share;
     let sharing = settings.shares_maps();
     let pools = pools(state);
     let batch = batch_for(&mut state.batch, settings);
