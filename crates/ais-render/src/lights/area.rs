@@ -387,7 +387,8 @@ impl AreaLight {
 
     /// Which of the unbounded rays from `origin` along `directions` surely miss the light,
     /// found over lanes by the first test of its own intersection ([`AreaLight::intersect`]
-    /// then finds nothing either): a sphere's chord, a mesh's ball. None for other shapes.
+    /// then finds nothing either): a sphere's chord, a mesh's ball. For other shapes, no
+    /// lane.
     #[inline(always)]
     pub(super) fn missed_along<const N: usize>(
         &self,

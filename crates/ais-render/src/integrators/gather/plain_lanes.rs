@@ -126,11 +126,12 @@ struct Lanes {
     /// A BSDF-drawn candidate's specular lobe (a point mass), where one gave it.
     specular: [Option<SpecularMass>; RUN],
     /// Whether its shadow ray is left to the pixel's pool to trace (then `free` holds until
-    /// the pool finds otherwise), whether the ray ends, and the point it ends at. `deferred`
-    /// is set only for candidates whose ray is needed, and read only where `free` is set: a
-    /// lane whose ray is not needed may hold an earlier run's; the others, only where
-    /// `deferred` is. (Two arrays, not one of `Option<Vec3>`: an option written a field at
-    /// a time and copied whole waits for the stores to complete.)
+    /// the pool finds otherwise), whether the ray ends, and the point it ends at (where it
+    /// ends). All three are set only for candidates whose ray is needed: a lane whose ray
+    /// is not needed may hold an earlier run's. `deferred` is read only where `free` is
+    /// set, the other two only where `deferred` is. (Two arrays, not one of
+    /// `Option<Vec3>`: an option written a field at a time and copied whole waited for the
+    /// writes.)
     deferred: [bool; RUN],
     bounded: [bool; RUN],
     target: [Vec3; RUN],
