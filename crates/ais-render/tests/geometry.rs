@@ -103,6 +103,11 @@ fn rectangle_from_mitsuba_transform() {
 
 /// Random triangles and spheres in a box.
 fn random_scene(rng: &mut Pcg32) -> Geometry {
+    Geometry::build(random_shapes(rng))
+}
+
+/// The shapes of [`random_scene`].
+fn random_shapes(rng: &mut Pcg32) -> Vec<ShapeInput> {
     let mut mesh = TriangleMesh::default();
     for t in 0..2000u32 {
         let center = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 10.0;
@@ -126,7 +131,76 @@ fn random_scene(rng: &mut Pcg32) -> Geometry {
             rotation: None,
         });
     }
-    Geometry::build(shapes)
+    shapes
+}
+
+/// [`random_scene`]'s shapes over a ground of two triangles 40 wide, below them at y = -1,
+/// with more area than all of theirs (the geometry keeps it out of the BVH); the ground is
+/// the last shape.
+fn random_scene_on_a_ground(rng: &mut Pcg32) -> (Geometry, u32) {
+    let mut shapes = random_shapes(rng);
+    let corners = [(-15.0, -15.0), (25.0, -15.0), (25.0, 25.0), (-15.0, 25.0)];
+    let [a, b, c, d] = corners.map(|(x, z)| Vec3::new(x, -1.0, z));
+    shapes.push(triangles_shape(vec![a, b, c, a, c, d]));
+    let ground = shapes.len() as u32 - 1;
+    (Geometry::build(shapes), ground)
+}
+
+#[test]
+fn a_ground_kept_out_of_the_bvh_is_met_as_brute_force_meets_it() {
+    let mut rng = Pcg32::new(41, 9);
+    let (geometry, ground) = random_scene_on_a_ground(&mut rng);
+    let (mut on_ground, mut from_ground_free) = (0, 0);
+    for i in 0..6000 {
+        let direction = random_unit(&mut rng);
+        // Half the rays leave the ground (up or down, offset as the renderer offsets
+        // them), half start anywhere above it.
+        let origin = match i % 2 {
+            0 => {
+                let point = Vec3::new(
+                    40.0 * rng.next_f32() - 15.0,
+                    -1.0,
+                    40.0 * rng.next_f32() - 15.0,
+                );
+                offset_origin(point, Vec3::Y, direction)
+            }
+            _ => Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0,
+        };
+        let mut ray = Ray::new(origin, direction);
+        if i % 3 == 0 {
+            ray.t_max = 3.0 * rng.next_f32();
+        }
+        let fast = geometry.intersect(&ray);
+        let slow = geometry.intersect_brute_force(&ray);
+        match (fast, slow) {
+            (Some(a), Some(b)) => {
+                assert!(
+                    (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
+                    "ray {i}: {} vs {}",
+                    a.t,
+                    b.t
+                );
+                assert_eq!(a.shape, b.shape, "ray {i}");
+                on_ground += (b.shape == ground) as usize;
+            }
+            (None, None) => from_ground_free += (i % 2 == 0) as usize,
+            (a, b) => panic!("ray {i}: BVH {a:?} vs brute force {b:?}"),
+        }
+        assert_eq!(
+            geometry.occluded(&ray),
+            slow.is_some(),
+            "ray {i}: occlusion"
+        );
+        let mut blockers = RecentBlockers::default();
+        for _ in 0..2 {
+            let after = geometry.occluded_after(&ray, &mut blockers);
+            assert_eq!(after, slow.is_some(), "ray {i}: after a blocker");
+        }
+    }
+    assert!(
+        on_ground > 300 && from_ground_free > 1000,
+        "{on_ground} {from_ground_free}"
+    );
 }
 
 #[test]

@@ -1,7 +1,9 @@
 //! obvhs's compressed wide BVH with its triangles in lanes: traversal visits the nodes as
 //! obvhs does, and tests the primitives a node hands over all together, the triangles eight
-//! at a time ([`TriangleLanes`]) and the rest one by one through the caller.
+//! at a time ([`TriangleLanes`]) and the rest one by one through the caller. A ground kept
+//! out of the BVH ([`Ground`]) is tested first, as one more group.
 
+use super::ground::Ground;
 use super::primitive::Packed;
 use super::ray::Ray;
 use super::shaft::Shaft;
@@ -31,19 +33,29 @@ macro_rules! walk {
 /// for a BVH deeper than obvhs allows).
 const SHAFT_STACK: usize = 256;
 
-/// A CWBVH and its primitives' triangles in lanes.
+/// A CWBVH and its primitives' triangles in lanes, and a ground kept out of it.
 pub(super) struct LanedBvh {
     bvh: CwBvh,
     lanes: TriangleLanes,
+    ground: Option<Ground>,
 }
 
 impl LanedBvh {
-    /// `bvh` over `packed`, the primitives in the BVH's order.
-    pub(super) fn new(bvh: CwBvh, packed: &[Packed]) -> Self {
+    /// `bvh` over `packed`, the primitives in the BVH's order, then those of `ground`.
+    pub(super) fn new(bvh: CwBvh, packed: &[Packed], ground: Option<Ground>) -> Self {
         LanedBvh {
             lanes: TriangleLanes::new(packed),
             bvh,
+            ground,
         }
+    }
+
+    /// The ground's primitives that `ray` may meet, as a BVH node hands them over (none
+    /// when there is no ground, or the ray leaves it).
+    #[inline(always)]
+    fn ground_group(&self, ray: &Ray) -> Option<(u32, u32)> {
+        let ground = self.ground.as_ref()?;
+        ground.may_meet(ray).then(|| ground.group())
     }
 
     /// The primitive that blocks `ray` before its end, if any (the first found, not the
@@ -53,6 +65,11 @@ impl LanedBvh {
         ray: &Ray,
         mut blocks: impl FnMut(usize, f32) -> bool,
     ) -> Option<usize> {
+        if let Some((base, group)) = self.ground_group(ray) {
+            if let Some(index) = self.lanes.any_hit(base, group, ray, ray.t_max) {
+                return Some(index);
+            }
+        }
         let bvh_ray = ray.to_bvh(ray.t_max);
         let mut blocker = None;
         'traversal: {
@@ -100,9 +117,15 @@ impl LanedBvh {
     /// which answers for each primitive in a node box that reaches into the shaft; stops
     /// at the first that does not.
     pub(super) fn clear_of(&self, shaft: &Shaft, mut outside: impl FnMut(usize) -> bool) -> bool {
+        // The ground last: a shaft that is not clear is mostly found so in the BVH first.
+        self.bvh_clear_of(shaft, &mut outside)
+            && (self.ground.as_ref()).is_none_or(|ground| ground.clear_of(shaft, &mut outside))
+    }
+
+    /// [`LanedBvh::clear_of`] for the primitives in the BVH.
+    fn bvh_clear_of(&self, shaft: &Shaft, outside: &mut impl FnMut(usize) -> bool) -> bool {
         let total = &self.bvh.total_aabb;
-        let magnitude = Vec3A::max(total.min.abs(), total.max.abs()).max_element();
-        let margin = shaft.margin_for(magnitude);
+        let margin = shaft.margin_for_box(total);
         if self.bvh.nodes.is_empty() || shaft.excludes_box(total, margin) {
             return true;
         }
@@ -148,6 +171,16 @@ impl LanedBvh {
     ) -> Option<Closest> {
         let mut bvh_ray = ray.to_bvh(ray.t_max);
         let mut nearest = None;
+        if let Some((base, group)) = self.ground_group(ray) {
+            if let Some(lane_hit) = self.lanes.nearest(base, group, ray, bvh_ray.tmax) {
+                bvh_ray.tmax = lane_hit.t;
+                nearest = Some(Closest::Primitive {
+                    index: lane_hit.index,
+                    t: lane_hit.t,
+                    barycentrics: lane_hit.barycentrics,
+                });
+            }
+        }
         walk!(self, bvh_ray, state, {
             let (base, group) = take_group(&mut state);
             if let Some(lane_hit) = self.lanes.nearest(base, group, ray, bvh_ray.tmax) {

@@ -6,12 +6,14 @@ mod basis;
 mod cwbvh_traversal;
 #[cfg(feature = "embree")]
 mod embree;
+mod ground;
 mod instances;
 mod primitive;
 mod quadric;
 mod ray;
 mod recent_blockers;
 mod shaft;
+mod slab;
 mod triangle_lanes;
 
 pub use basis::basis;
@@ -27,6 +29,7 @@ pub use shaft::{LeavingSurface, Shaft};
 use crate::mesh::{AttributeSite, MeshAttribute, TriangleMesh};
 use cwbvh_traversal::LanedBvh;
 use glam::{Vec2, Vec3};
+use ground::Ground;
 use std::time::{Duration, Instant};
 
 /// What one shape contributes, in world space.
@@ -317,20 +320,31 @@ impl Geometry {
         self.build_cwbvh();
     }
 
-    /// Builds the CWBVH and packs the primitives in its order, so that traversal needs no
-    /// indirection.
+    /// Builds the CWBVH over the primitives but a ground (see [`ground`]), and packs them
+    /// in its order, so that traversal needs no indirection, the ground's last.
     fn build_cwbvh(&mut self) {
         let primitives = std::mem::take(&mut self.primitives);
         if primitives.is_empty() {
             return;
         }
+        let ground = ground::choose(&primitives);
+        let in_bvh: Vec<u32> = (0..primitives.len() as u32)
+            .filter(|&i| !ground.contains(&(i as usize)))
+            .collect();
+        let bvh_primitives: Vec<Primitive> =
+            in_bvh.iter().map(|&i| primitives[i as usize]).collect();
         let bvh = obvhs::cwbvh::builder::build_cwbvh(
-            &primitives,
+            &bvh_primitives,
             obvhs::BvhBuildParams::medium_build(),
             &mut Duration::default(),
         );
-        self.pack_in_order(&primitives, &bvh.primitive_indices);
-        self.accelerator = Some(Accelerator::Cwbvh(LanedBvh::new(bvh, &self.packed)));
+        let order: Vec<u32> = (bvh.primitive_indices.iter())
+            .map(|&i| in_bvh[i as usize])
+            .chain(ground.iter().map(|&i| i as u32))
+            .collect();
+        self.pack_in_order(&primitives, &order);
+        let ground = (!ground.is_empty()).then(|| Ground::new(&self.packed, in_bvh.len()));
+        self.accelerator = Some(Accelerator::Cwbvh(LanedBvh::new(bvh, &self.packed, ground)));
     }
 
     /// Packs the primitives with the triangles first, as Embree's scene numbers them, and

@@ -187,6 +187,12 @@ impl Shaft {
         RELATIVE_MARGIN * (magnitude + self.apex_magnitude + 1.0)
     }
 
+    /// [`Shaft::margin_for`] the largest coordinate of `aabb`.
+    pub(crate) fn margin_for_box(&self, aabb: &Aabb) -> f32 {
+        let magnitude = Vec3::from(aabb.min.abs().max(aabb.max.abs())).max_element();
+        self.margin_for(magnitude)
+    }
+
     /// Whether `aabb` lies wholly outside the shaft, by `margin` ([`Shaft::margin_for`]).
     #[inline]
     pub fn excludes_box(&self, aabb: &Aabb, margin: f32) -> bool {

@@ -100,7 +100,7 @@ impl TriangleLanes {
 
     /// A triangle among `group` (bit k: primitive `base + k`) that blocks `ray` before
     /// `t_max`, if any.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn any_hit(&self, base: u32, group: u32, ray: &Ray, t_max: f32) -> Option<usize> {
         let first_run = base as usize / LANES;
         let mut lanes = (group as u64) << (base as usize % LANES);
@@ -132,7 +132,7 @@ impl TriangleLanes {
     /// The nearest triangle among `group` (bit k: primitive `base + k`) that `ray` hits
     /// before `t_max`. Of equally near ones, the one of highest index, as a test of one
     /// primitive after another from the highest down keeps.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn nearest(&self, base: u32, group: u32, ray: &Ray, t_max: f32) -> Option<LaneHit> {
         let first_run = base as usize / LANES;
         let lanes = (group as u64) << (base as usize % LANES);
