@@ -2,8 +2,8 @@
 
 use ais::rng::Pcg32;
 use ais_render::geometry::{
-    offset_origin, spawn_ray, spawn_ray_to, Geometry, LeavingSurface, Ray, RecentBlockers, Shaft,
-    ShapeGeometry, ShapeInput, Sphere, Triangle,
+    offset_origin, spawn_ray, spawn_ray_to, Geometry, Hit, LeavingSurface, Ray, RecentBlockers,
+    Shaft, ShapeGeometry, ShapeInput, Sphere, Triangle,
 };
 use ais_render::mesh::TriangleMesh;
 use ais_render::shapes;
@@ -172,19 +172,9 @@ fn a_ground_kept_out_of_the_bvh_is_met_as_brute_force_meets_it() {
         }
         let fast = geometry.intersect(&ray);
         let slow = geometry.intersect_brute_force(&ray);
-        match (fast, slow) {
-            (Some(a), Some(b)) => {
-                assert!(
-                    (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
-                    "ray {i}: {} vs {}",
-                    a.t,
-                    b.t
-                );
-                assert_eq!(a.shape, b.shape, "ray {i}");
-                on_ground += (b.shape == ground) as usize;
-            }
-            (None, None) => from_ground_free += (i % 2 == 0) as usize,
-            (a, b) => panic!("ray {i}: BVH {a:?} vs brute force {b:?}"),
+        match same_hit(i, fast, slow) {
+            Some(shape) => on_ground += (shape == ground) as usize,
+            None => from_ground_free += (i % 2 == 0) as usize,
         }
         assert_eq!(
             geometry.occluded(&ray),
@@ -201,6 +191,21 @@ fn a_ground_kept_out_of_the_bvh_is_met_as_brute_force_meets_it() {
         on_ground > 300 && from_ground_free > 1000,
         "{on_ground} {from_ground_free}"
     );
+}
+
+/// Checks that ray `i`'s hit by the BVH (`fast`) is brute force's (`slow`): the same
+/// shape at the same distance, or no hit for both. The shape hit, if any.
+fn same_hit(i: usize, fast: Option<Hit>, slow: Option<Hit>) -> Option<u32> {
+    match (fast, slow) {
+        (Some(a), Some(b)) => {
+            let t_agrees = (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0);
+            assert!(t_agrees, "ray {i}: {} vs {}", a.t, b.t);
+            assert_eq!(a.shape, b.shape, "ray {i}");
+            Some(b.shape)
+        }
+        (None, None) => None,
+        (a, b) => panic!("ray {i}: BVH {a:?} vs brute force {b:?}"),
+    }
 }
 
 #[test]
@@ -223,20 +228,7 @@ fn bvh_agrees_with_brute_force_on_random_rays() {
         }
         let fast = geometry.intersect(&ray);
         let slow = geometry.intersect_brute_force(&ray);
-        match (fast, slow) {
-            (Some(a), Some(b)) => {
-                assert!(
-                    (a.t - b.t).abs() <= 1e-5 * b.t.max(1.0),
-                    "ray {i}: {} vs {}",
-                    a.t,
-                    b.t
-                );
-                assert_eq!(a.shape, b.shape, "ray {i}");
-                hits += 1;
-            }
-            (None, None) => {}
-            (a, b) => panic!("ray {i}: BVH {a:?} vs brute force {b:?}"),
-        }
+        hits += same_hit(i, fast, slow).is_some() as usize;
         assert_eq!(
             geometry.occluded(&ray),
             slow.is_some(),

@@ -37,7 +37,8 @@ const SHAFT_STACK: usize = 256;
 pub(super) struct LanedBvh {
     bvh: CwBvh,
     lanes: TriangleLanes,
-    ground: Option<Ground>,
+    /// Boxed: it is larger than the other accelerators.
+    ground: Option<Box<Ground>>,
 }
 
 impl LanedBvh {
@@ -46,7 +47,7 @@ impl LanedBvh {
         LanedBvh {
             lanes: TriangleLanes::new(packed),
             bvh,
-            ground,
+            ground: ground.map(Box::new),
         }
     }
 
@@ -174,22 +175,14 @@ impl LanedBvh {
         if let Some((base, group)) = self.ground_group(ray) {
             if let Some(lane_hit) = self.lanes.nearest(base, group, ray, bvh_ray.tmax) {
                 bvh_ray.tmax = lane_hit.t;
-                nearest = Some(Closest::Primitive {
-                    index: lane_hit.index,
-                    t: lane_hit.t,
-                    barycentrics: lane_hit.barycentrics,
-                });
+                nearest = Some(Closest::of(lane_hit));
             }
         }
         walk!(self, bvh_ray, state, {
             let (base, group) = take_group(&mut state);
             if let Some(lane_hit) = self.lanes.nearest(base, group, ray, bvh_ray.tmax) {
                 bvh_ray.tmax = lane_hit.t;
-                nearest = Some(Closest::Primitive {
-                    index: lane_hit.index,
-                    t: lane_hit.t,
-                    barycentrics: lane_hit.barycentrics,
-                });
+                nearest = Some(Closest::of(lane_hit));
             }
             for index in indices(base, self.lanes.others(base, group)) {
                 if let Some(closest) = hit(index, bvh_ray.tmax) {

@@ -156,6 +156,16 @@ enum Closest {
 }
 
 impl Closest {
+    /// A triangle hit found in the lanes.
+    #[inline(always)]
+    fn of(hit: triangle_lanes::LaneHit) -> Self {
+        Closest::Primitive {
+            index: hit.index,
+            t: hit.t,
+            barycentrics: hit.barycentrics,
+        }
+    }
+
     fn t(&self) -> f32 {
         match self {
             Closest::Primitive { t, .. } => *t,
