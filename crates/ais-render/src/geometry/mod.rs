@@ -353,7 +353,8 @@ impl Geometry {
             .chain(ground.iter().map(|&i| i as u32))
             .collect();
         self.pack_in_order(&primitives, &order);
-        let ground = (!ground.is_empty()).then(|| Ground::new(&self.packed, in_bvh.len()));
+        let first = bvh.primitive_indices.len();
+        let ground = (!ground.is_empty()).then(|| Ground::new(&self.packed, first));
         self.accelerator = Some(Accelerator::Cwbvh(LanedBvh::new(bvh, &self.packed, ground)));
     }
 

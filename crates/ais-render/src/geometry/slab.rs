@@ -1,6 +1,7 @@
 //! A slab that holds flat triangles: the space between two parallel planes. A ray that
-//! starts outside it and points away from it hits none of them, which lets a ray that
-//! leaves a ground skip the ground's triangles with a test of one plane.
+//! starts outside it and points away from it, or ends before reaching it, hits none of
+//! them, which lets a ray that leaves a ground skip the ground's triangles with a test of
+//! one plane.
 
 use super::ray::Ray;
 use glam::{DVec3, Vec3};
