@@ -11,7 +11,7 @@ use super::primitive::{Packed, Primitive};
 use super::ray::Ray;
 use super::shaft::Shaft;
 use super::slab::Slab;
-use glam::Vec3;
+use glam::{DVec3, Vec3};
 use obvhs::aabb::Aabb;
 
 /// The most triangles a ground holds: one run of the triangle lanes.
@@ -19,6 +19,12 @@ const MOST_TRIANGLES: usize = 8;
 
 /// The least share of all the triangles' area a ground holds.
 const LEAST_SHARE: f64 = 0.5;
+
+/// How far, as a fraction of a triangle's largest coordinate, another triangle's corners may
+/// lie from its plane and still count as lying in it: the rounding of a modelled floor's
+/// corners to f32, not a bend a ray could slip through unseen by the slab (the slab holds
+/// every corner exactly).
+const FLATNESS: f64 = 1.0 / 1_048_576.0;
 
 /// Which of `primitives` (by index) to keep apart as the ground: the largest flat part of
 /// the eight largest triangles, if it holds at least half of all the triangles' area, and
@@ -37,19 +43,55 @@ pub(super) fn choose(primitives: &[Primitive]) -> Vec<usize> {
     triangles.sort_by(|a, b| area(&b.1).total_cmp(&area(&a.1)));
     triangles.truncate(MOST_TRIANGLES);
     let largest: Vec<[Vec3; 3]> = triangles.iter().map(|&(_, triangle)| triangle).collect();
-    let (_, part) = Slab::around_flattest(&largest);
-    let chosen: Vec<usize> = (0..triangles.len())
+    let part = largest_flat_part(&largest);
+    let chosen: Vec<(usize, [Vec3; 3])> = (0..triangles.len())
         .filter(|&k| part & 1 << k != 0)
-        .map(|k| triangles[k].0)
+        .map(|k| triangles[k])
         .collect();
-    let held: f64 = (0..largest.len())
-        .filter(|&k| part & 1 << k != 0)
-        .map(|k| area(&largest[k]))
-        .sum();
+    let held: f64 = chosen.iter().map(|(_, triangle)| area(triangle)).sum();
     match held >= LEAST_SHARE * total && held > 0.0 && chosen.len() < primitives.len() {
-        true => chosen,
+        true => chosen.into_iter().map(|(index, _)| index).collect(),
         false => Vec::new(),
     }
+}
+
+/// The largest flat part of `triangles` (the most area in one plane, among the planes of
+/// the triangles themselves), as a bit for each triangle in it; triangles without an area
+/// belong to no part. At most 32 triangles.
+fn largest_flat_part(triangles: &[[Vec3; 3]]) -> u32 {
+    assert!(triangles.len() <= 32, "a part is named by 32 bits");
+    let normals: Vec<DVec3> = triangles
+        .iter()
+        .map(|&[_, e1, e2]| e1.as_dvec3().cross(e2.as_dvec3()))
+        .collect();
+    let in_plane_of = |i: usize| -> u32 {
+        let Some(normal) = normals[i].try_normalize() else {
+            return 0;
+        };
+        let [v0, e1, e2] = triangles[i];
+        let magnitude = v0.abs().max((v0 + e1).abs()).max((v0 + e2).abs());
+        let tolerance = FLATNESS * f64::from(magnitude.max_element());
+        let height = |corner: DVec3| normal.dot(corner - v0.as_dvec3()).abs();
+        (0..triangles.len())
+            .filter(|&j| {
+                let [w0, f1, f2] = triangles[j].map(Vec3::as_dvec3);
+                normals[j].length_squared() > 0.0
+                    && [w0, w0 + f1, w0 + f2]
+                        .into_iter()
+                        .all(|c| height(c) <= tolerance)
+            })
+            .fold(0, |bits, j| bits | 1 << j)
+    };
+    let area = |bits: u32| {
+        (0..normals.len())
+            .filter(|&j| bits & 1 << j != 0)
+            .map(|j| normals[j].length())
+            .sum::<f64>()
+    };
+    (0..triangles.len())
+        .map(in_plane_of)
+        .max_by(|&a, &b| area(a).total_cmp(&area(b)))
+        .unwrap_or(0)
 }
 
 /// The ground: the packed primitives `first..first + count`, after the BVH's own, all

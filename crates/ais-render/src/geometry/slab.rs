@@ -18,12 +18,6 @@ const ORIGIN_MARGIN: f32 = 1.0 / 1_048_576.0;
 /// the grazing cases its own rounding makes.
 const DIRECTION_MARGIN: f32 = 1e-6;
 
-/// How far, as a fraction of a triangle's largest coordinate, another triangle's corners may
-/// lie from its plane and still count as lying in it: the rounding of a modelled floor's
-/// corners to f32, not a bend a ray could slip through unseen by the slab (the slab holds
-/// every corner exactly).
-const FLATNESS: f64 = 1.0 / 1_048_576.0;
-
 /// The points within `half_thickness` of the plane through `center` with normal `normal`
 /// (heights measured in f32's `normal` exactly); an infinitely thick one holds everything
 /// and excludes no ray.
@@ -76,50 +70,6 @@ impl Slab {
             // Widened by the f64 arithmetic's own rounding, then rounded up to an f32.
             half_thickness: ((thickest * (1.0 + 1e-9) + 1e-30) as f32).next_up(),
         }
-    }
-
-    /// The slab around the largest flat part of `triangles` (the most area in one plane,
-    /// among the planes of the triangles themselves), and which triangles it holds (bit k:
-    /// `triangles[k]`); triangles without an area belong to no part. At most 32 triangles.
-    pub(crate) fn around_flattest(triangles: &[[Vec3; 3]]) -> (Slab, u32) {
-        assert!(triangles.len() <= 32, "a slab's part is named by 32 bits");
-        let normals: Vec<DVec3> = triangles
-            .iter()
-            .map(|&[_, e1, e2]| e1.as_dvec3().cross(e2.as_dvec3()))
-            .collect();
-        let in_plane_of = |i: usize| -> u32 {
-            let Some(normal) = normals[i].try_normalize() else {
-                return 0;
-            };
-            let [v0, e1, e2] = triangles[i];
-            let magnitude = v0.abs().max((v0 + e1).abs()).max((v0 + e2).abs());
-            let tolerance = FLATNESS * f64::from(magnitude.max_element());
-            let height = |corner: DVec3| normal.dot(corner - v0.as_dvec3()).abs();
-            (0..triangles.len())
-                .filter(|&j| {
-                    let [w0, f1, f2] = triangles[j].map(Vec3::as_dvec3);
-                    normals[j].length_squared() > 0.0
-                        && [w0, w0 + f1, w0 + f2]
-                            .into_iter()
-                            .all(|c| height(c) <= tolerance)
-                })
-                .fold(0, |bits, j| bits | 1 << j)
-        };
-        let area = |bits: u32| {
-            (0..normals.len())
-                .filter(|&j| bits & 1 << j != 0)
-                .map(|j| normals[j].length())
-                .sum::<f64>()
-        };
-        let best = (0..triangles.len())
-            .map(in_plane_of)
-            .max_by(|&a, &b| area(a).total_cmp(&area(b)))
-            .unwrap_or(0);
-        let part: Vec<[Vec3; 3]> = (0..triangles.len())
-            .filter(|&j| best & 1 << j != 0)
-            .map(|j| triangles[j])
-            .collect();
-        (Slab::around(&part), best)
     }
 
     /// Whether `ray` stays clear of the slab: it starts outside the slab, and points away
