@@ -543,7 +543,10 @@ mod tests {
         </scene>"#
         );
         std::fs::write(dir.join("scene.xml"), xml).unwrap();
-        World::from_description(load_scene(&dir.join("scene.xml"), &[]).unwrap()).unwrap()
+        let world = World::from_description(load_scene(&dir.join("scene.xml"), &[]).unwrap());
+        // The world holds the sky in memory; the files are not needed once it is built.
+        std::fs::remove_dir_all(&dir).unwrap();
+        world.unwrap()
     }
 
     /// Two guides of `partition`'s texels: the product alone, and mixed half and half.
