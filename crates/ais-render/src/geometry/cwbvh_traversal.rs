@@ -4,6 +4,7 @@
 //! out of the BVH ([`Ground`]) is tested first, as one more group.
 
 use super::ground::Ground;
+use super::outer_box::OuterBox;
 use super::primitive::Packed;
 use super::ray::Ray;
 use super::shaft::Shaft;
@@ -37,16 +38,26 @@ const SHAFT_STACK: usize = 256;
 pub(super) struct LanedBvh {
     bvh: CwBvh,
     lanes: TriangleLanes,
+    /// The box around the BVH's primitives, which a ray that passes it by need not
+    /// traverse.
+    outer: OuterBox,
     /// Boxed: it is larger than the other accelerators.
     ground: Option<Box<Ground>>,
 }
 
 impl LanedBvh {
-    /// `bvh` over `packed`, the primitives in the BVH's order, then those of `ground`.
-    pub(super) fn new(bvh: CwBvh, packed: &[Packed], ground: Option<Ground>) -> Self {
+    /// `bvh` over `packed`, the primitives in the BVH's order (inside `outer`), then those
+    /// of `ground`.
+    pub(super) fn new(
+        bvh: CwBvh,
+        packed: &[Packed],
+        outer: OuterBox,
+        ground: Option<Ground>,
+    ) -> Self {
         LanedBvh {
             lanes: TriangleLanes::new(packed),
             bvh,
+            outer,
             ground: ground.map(Box::new),
         }
     }
@@ -70,6 +81,9 @@ impl LanedBvh {
             if let Some(index) = self.lanes.any_hit(base, group, ray, ray.t_max) {
                 return Some(index);
             }
+        }
+        if self.outer.passed_by(ray, ray.t_max) {
+            return None;
         }
         let bvh_ray = ray.to_bvh(ray.t_max);
         let mut blocker = None;
@@ -177,6 +191,9 @@ impl LanedBvh {
                 bvh_ray.tmax = lane_hit.t;
                 nearest = Some(Closest::of(lane_hit));
             }
+        }
+        if self.outer.passed_by(ray, bvh_ray.tmax) {
+            return nearest;
         }
         walk!(self, bvh_ray, state, {
             let (base, group) = take_group(&mut state);
