@@ -40,6 +40,15 @@ pub struct MeshEmitter {
     outline: Option<[Vec3; 4]>,
 }
 
+/// A point drawn on an emitting mesh, before its direction from the receiver is known.
+#[derive(Clone, Copy, Debug, Default)]
+struct MeshSpot {
+    /// The point.
+    point: Vec3,
+    /// Its triangle and barycentric coordinates.
+    spot: LightSpot,
+}
+
 impl MeshEmitter {
     /// The mesh of `triangles` (at least one), with their texture coordinates if a texture
     /// gives the radiance.
@@ -100,13 +109,15 @@ impl MeshEmitter {
     /// in solid angle of drawing that point ([`MeshEmitter::pdf`] sums it over every
     /// crossing of the direction), its distance and the triangle's normal.
     pub fn sample(&self, point: Vec3, u: [f32; 2]) -> Option<AreaSample> {
-        self.sample_on(point, self.pick(u[0]), u[1])
+        self.toward(point, self.spot_on(self.pick(u[0]), u[1]))
     }
 
     /// [`MeshEmitter::sample`] for each of `squares` (at most a run of sixteen), the points
     /// given to `put` with their index in `squares`: every triangle picked first, then
-    /// every point. A draw waits on two lookups, the triangle's alias bin and then its
-    /// vertices; made in two passes, the run's waits overlap.
+    /// every point, then every direction. A draw waits on two lookups, the triangle's alias
+    /// bin and then its vertices; made in passes, the run's waits overlap (the directions'
+    /// square roots and divisions, made with the points, kept too few of the vertices'
+    /// loads in flight).
     #[inline(always)]
     pub fn sample_run(
         &self,
@@ -118,8 +129,12 @@ impl MeshEmitter {
         for (pick, square) in picks.iter_mut().zip(squares) {
             *pick = self.pick(square[0]);
         }
-        for (k, (&pick, square)) in picks.iter().zip(squares).enumerate() {
-            if let Some(sample) = self.sample_on(point, pick, square[1]) {
+        let mut spots = [MeshSpot::default(); RUN];
+        for ((spot, &pick), square) in spots.iter_mut().zip(&picks).zip(squares) {
+            *spot = self.spot_on(pick, square[1]);
+        }
+        for (k, &spot) in spots[..squares.len()].iter().enumerate() {
+            if let Some(sample) = self.toward(point, spot) {
                 put(k, &sample);
             }
         }
@@ -134,22 +149,32 @@ impl MeshEmitter {
 
     /// The second step of [`MeshEmitter::sample`]: a point of the triangle `picked` (from
     /// [`MeshEmitter::pick`]) drawn with what was left of its number and `u1`.
-    #[inline]
-    fn sample_on(&self, point: Vec3, picked: (usize, f32), u1: f32) -> Option<AreaSample> {
+    #[inline(always)]
+    fn spot_on(&self, picked: (usize, f32), u1: f32) -> MeshSpot {
         let (index, u0) = picked;
-        let u = [u0, u1];
-        let triangle = &self.triangles[index];
         let su = u0.sqrt();
-        let (b1, b2) = (1.0 - su, u[1] * su);
-        let [v0, v1, v2] = triangle.vertices;
-        let target = v0 * (1.0 - b1 - b2) + v1 * b1 + v2 * b2;
-        let offset = target - point;
+        let (b1, b2) = (1.0 - su, u1 * su);
+        let [v0, v1, v2] = self.triangles[index].vertices;
+        MeshSpot {
+            point: v0 * (1.0 - b1 - b2) + v1 * b1 + v2 * b2,
+            spot: LightSpot {
+                triangle: index as u32,
+                barycentrics: Vec2::new(b1, b2),
+            },
+        }
+    }
+
+    /// The last step of [`MeshEmitter::sample`]: the direction from `point` toward `spot`,
+    /// and its density (none where the two coincide, or the triangle is seen edge-on).
+    #[inline(always)]
+    fn toward(&self, point: Vec3, spot: MeshSpot) -> Option<AreaSample> {
+        let offset = spot.point - point;
         let distance_squared = offset.length_squared() as f64;
         if distance_squared == 0.0 {
             return None;
         }
         let direction = offset.normalize();
-        let normal = self.normals[index];
+        let normal = self.normals[spot.spot.triangle as usize];
         let distance = distance_squared.sqrt() as f32;
         let pdf = self.density_at(direction, distance, normal);
         (pdf > 0.0).then_some(AreaSample {
@@ -157,10 +182,7 @@ impl MeshEmitter {
             pdf,
             distance,
             normal,
-            spot: LightSpot {
-                triangle: index as u32,
-                barycentrics: Vec2::new(b1, b2),
-            },
+            spot: spot.spot,
         })
     }
 
