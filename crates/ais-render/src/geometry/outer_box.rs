@@ -1,8 +1,8 @@
 //! The box around everything a BVH holds, tried before its traversal. Under an open sky
 //! most shadow rays pass by every object, and a traversal pays for setting up and for the
 //! root's eight children (decoded from 8-bit offsets) to learn that; one exact box test
-//! learns it for less. Rays that start among the objects (a room's) always enter the box
-//! and pay for the test: a few instructions.
+//! learns it for less. Rays that start among the objects (a room's) always enter the box,
+//! which six comparisons of their origin show.
 
 use super::ray::Ray;
 use glam::Vec3A;
