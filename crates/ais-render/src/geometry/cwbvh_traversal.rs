@@ -46,18 +46,13 @@ pub(super) struct LanedBvh {
 }
 
 impl LanedBvh {
-    /// `bvh` over `packed`, the primitives in the BVH's order (inside `outer`), then those
-    /// of `ground`.
-    pub(super) fn new(
-        bvh: CwBvh,
-        packed: &[Packed],
-        outer: OuterBox,
-        ground: Option<Ground>,
-    ) -> Self {
+    /// `bvh` over `packed`, the primitives in the BVH's order, then those of `ground`.
+    pub(super) fn new(bvh: CwBvh, packed: &[Packed], ground: Option<Ground>) -> Self {
         LanedBvh {
             lanes: TriangleLanes::new(packed),
+            // The BVH's own box is the union of its primitives' boxes.
+            outer: OuterBox::around(&bvh.total_aabb),
             bvh,
-            outer,
             ground: ground.map(Box::new),
         }
     }

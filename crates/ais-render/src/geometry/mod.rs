@@ -31,7 +31,6 @@ use crate::mesh::{AttributeSite, MeshAttribute, TriangleMesh};
 use cwbvh_traversal::LanedBvh;
 use glam::{Vec2, Vec3};
 use ground::Ground;
-use outer_box::OuterBox;
 use std::time::{Duration, Instant};
 
 /// What one shape contributes, in world space.
@@ -357,9 +356,7 @@ impl Geometry {
         self.pack_in_order(&primitives, &order);
         let first = bvh.primitive_indices.len();
         let ground = (!ground.is_empty()).then(|| Ground::new(&self.packed, first));
-        let outer = OuterBox::around(&primitive_bounds(&bvh_primitives));
-        let laned = LanedBvh::new(bvh, &self.packed, outer, ground);
-        self.accelerator = Some(Accelerator::Cwbvh(laned));
+        self.accelerator = Some(Accelerator::Cwbvh(LanedBvh::new(bvh, &self.packed, ground)));
     }
 
     /// Packs the primitives with the triangles first, as Embree's scene numbers them, and
