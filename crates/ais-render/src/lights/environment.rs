@@ -49,15 +49,16 @@ pub struct EnvironmentMap {
     width: usize,
     height: usize,
     /// The image's texels (row-major) with a fourth lane, aligned: a texel is one 16-byte
-    /// load, and the bilinear lookup's lerps run on all channels at once.
+    /// load, and the bilinear lookup's lerps run on all channels at once. The fourth lane
+    /// of texel (c, r) holds the sampling density of cell (c, r), in solid angle (0 in the
+    /// last row, which starts no cell): a direction's density is read from the cache line
+    /// its radiance lookup reads first (the cell's corner is the lookup's first texel).
     texels: Vec<Vec4>,
     to_world: Mat3,
     to_local: Mat3,
     /// The `width × (height − 1)` cells by probability (row-major). Cell (c, r) has texel
     /// centres (c, r) and (c + 1, r + 1) at its corners.
     cells: CdfGrid,
-    /// The sampling density of each cell in solid angle (row-major, `width × (height − 1)`).
-    cell_density: Vec<f32>,
     /// cos θ of each texel row.
     row_cosines: Vec<f32>,
     mean_luminance: f64,
@@ -111,29 +112,25 @@ impl EnvironmentMap {
             |row: usize| 2.0 * PI / width as f64 * (row_cosines[row] - row_cosines[row + 1]);
         let weights = cell_weights(&image, &row_cosines);
         let total: f64 = weights.iter().sum();
-        let cell_density = weights
-            .iter()
-            .enumerate()
-            .map(|(cell, &w)| {
-                let probability = if total > 0.0 {
-                    w / total
-                } else {
-                    1.0 / weights.len() as f64
-                };
-                (probability / cell_solid_angle(cell / width)) as f32
-            })
-            .collect();
+        let cell_density = |cell: usize| {
+            let Some(&w) = weights.get(cell) else {
+                return 0.0; // the last row's texels start no cell
+            };
+            let probability = if total > 0.0 {
+                w / total
+            } else {
+                1.0 / weights.len() as f64
+            };
+            (probability / cell_solid_angle(cell / width)) as f32
+        };
         EnvironmentMap {
             cells: CdfGrid::new(&weights, width),
-            cell_density,
             to_local: to_world.inverse().as_mat3(),
             to_world: to_world.as_mat3(),
             width,
             height,
-            texels: image
-                .pixels
-                .iter()
-                .map(|&[r, g, b]| Vec4::new(r, g, b, 0.0))
+            texels: (image.pixels.iter().enumerate())
+                .map(|(texel, &[r, g, b])| Vec4::new(r, g, b, cell_density(texel)))
                 .collect(),
             row_cosines: row_cosines.iter().map(|&c| c as f32).collect(),
             mean_luminance: total / (4.0 * PI),
@@ -241,7 +238,7 @@ impl EnvironmentMap {
     /// The sampling density at a located direction, in solid angle.
     #[inline]
     pub(crate) fn density_at(&self, location: MapLocation) -> f32 {
-        self.cell_density[location.cell]
+        self.texels[location.cell].w
     }
 
     /// The radiance at a located direction.
@@ -271,7 +268,7 @@ impl EnvironmentMap {
 
     /// Number of sampling cells (`width × (height − 1)`, row-major).
     pub(crate) fn cell_count(&self) -> usize {
-        self.cell_density.len()
+        self.width * (self.height - 1)
     }
 
     /// Probability that sampling picks `cell`.
