@@ -3,7 +3,7 @@
 
     cargo build --release -p ais-cli
     python3 tools/bench_vs_mitsuba.py --setup scenes/sunlit_room.xml [more scenes] \\
-        [--spp 64] [--rays 16] [--size 128x128] [--runs 3] [--markdown]
+        [--spp 64] [--rays 16] [--size 128x128] [--runs 3] [--markdown] [--define NAME=VALUE]
 
 Same work in both renderers: the scene's camera at `--size`, `--spp` camera samples per
 pixel, and per camera sample `--rays` gather rays. ais runs its gather with MIS and AIS off
@@ -36,6 +36,7 @@ numpy, as tools/crosscheck.py does.
 """
 import argparse
 import glob
+import json
 import os
 import re
 import queue
@@ -53,10 +54,10 @@ ROOT = crosscheck.ROOT
 # Loads the scene, renders it once (the llvm variant compiles its kernels), prints "ready",
 # then renders it once more for every line read and prints that render's time.
 MITSUBA_CHILD = r"""
-import sys, time
+import json, sys, time
 import mitsuba as mi, drjit as dr
 mi.set_variant(sys.argv[2])
-scene = mi.load_file(sys.argv[1])
+scene = mi.load_file(sys.argv[1], **json.loads(sys.argv[4]))
 spp = int(sys.argv[3])
 def timed(seed):
     started = time.perf_counter()
@@ -112,7 +113,8 @@ class MitsubaRenderer:
         self.variant = variant
         # Its log goes to a file: a pipe nobody reads could fill and stall it.
         self.log = tempfile.TemporaryFile(mode="w+")
-        self.process = subprocess.Popen([sys.executable, "-c", MITSUBA_CHILD, self.copy, variant, str(args.spp)],
+        self.process = subprocess.Popen([sys.executable, "-c", MITSUBA_CHILD, self.copy, variant, str(args.spp),
+                                         json.dumps(dict(args.define))],
                                         stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.log,
                                         text=True, env=env)
         # Its answers are read by a thread, so that waiting for one can time out.
@@ -171,6 +173,7 @@ def ais_render(scene, threads, args, seed, binary=None):
                    "--integrator", "gather", "--strategy", "mis", "--rays", str(args.rays), "--ais", "off",
                    "--threads", str(threads), "--seed", str(seed), "--no-preview",
                    "-o", os.path.join(work, "ais.exr")]
+        command += [word for name, value in args.define for word in ("-D", f"{name}={value}")]
         done = subprocess.run(command, capture_output=True, text=True)
     if done.returncode != 0:
         crosscheck.fail_setup(f"`{' '.join(command)}` failed:\n{done.stderr.strip()}")
@@ -179,6 +182,14 @@ def ais_render(scene, threads, args, seed, binary=None):
     timed = re.search(r"render time\s+([0-9.]+) s \(([0-9.]+) threads busy", report)
     return {"time": float(timed.group(1)), "rays": int(counted.group(1)) + int(counted.group(2)),
             "busy": float(timed.group(2))}
+
+
+def define(text):
+    """A scene parameter from NAME=VALUE, as a (name, value) pair."""
+    name, equals, value = text.partition("=")
+    if not (name and equals):
+        raise argparse.ArgumentTypeError(f"{text!r} is not NAME=VALUE")
+    return name, value
 
 
 def median_or_none(values):
@@ -276,6 +287,8 @@ def main():
     parser.add_argument("--ais", default=os.path.join(ROOT, "target", "release", "ais"), help="the ais binary")
     parser.add_argument("--ais-embree", help="an ais binary built with --features embree, timed too")
     parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
+    parser.add_argument("--define", action="append", default=[], type=define, metavar="NAME=VALUE",
+                        help="a scene parameter for both renderers (ais's -D; Mitsuba's load_file)")
     args = parser.parse_args()
     if args.setup:
         python = crosscheck.setup_venv(args.venv)
