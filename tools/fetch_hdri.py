@@ -46,7 +46,10 @@ def unpack_package(version, folder):
         fail(f"npm pack {PACKAGE}@{version} failed: {packed.stderr.strip()}")
     tarball = os.path.join(folder, packed.stdout.strip().splitlines()[-1])
     with tarfile.open(tarball) as archive:
-        archive.extractall(folder, filter="data")
+        try:
+            archive.extractall(folder, filter="data")
+        except TypeError:  # a Python without extraction filters (before 3.11.4)
+            archive.extractall(folder)
     return os.path.join(folder, "package")
 
 
@@ -80,10 +83,16 @@ def main():
             if name not in available:
                 fail(f"no HDRI named {name!r} in {PACKAGE}@{args.version}; it has: {', '.join(available)}")
             path = os.path.join(ASSETS, f"{name}.exr")
+            data = exr_bytes(os.path.join(hdri, f"{name}.exr.js"))
             partial = path + ".tmp"
-            with open(partial, "wb") as f:
-                f.write(exr_bytes(os.path.join(hdri, f"{name}.exr.js")))
-            os.replace(partial, path)  # never a half-written file under the final name
+            try:
+                with open(partial, "wb") as f:
+                    f.write(data)
+                os.replace(partial, path)  # never a half-written file under the final name
+            except OSError as e:
+                if os.path.exists(partial):
+                    os.remove(partial)
+                fail(f"{path}: {e.strerror}")
             print(f"wrote {os.path.relpath(path, ROOT)}")
 
 
