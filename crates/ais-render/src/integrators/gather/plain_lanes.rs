@@ -12,7 +12,7 @@ use super::light::shadow_ray;
 use super::pixel_pool::{Brings, SkyLookup};
 use super::shared_origin::SharedOrigin;
 use super::strategy::{MisParts, MisPick, Strategy};
-use crate::bsdf::{diffuse_direction, DiffuseHit, SpecularMass};
+use crate::bsdf::{DiffuseHit, SpecularMass};
 use crate::lights::{
     Aim, AreaDraws, Draw, Environment, EnvironmentDraws, EnvironmentGuide, EnvironmentMap,
     MapLocation, MapWeights, Receiver, Source, Toward, LANES,
@@ -288,18 +288,13 @@ impl<'a> PlainLanes<'a> {
         lanes.drawn = [false; RUN];
         // A BSDF-drawn direction's source is found later, with the run's others ([`meet`]).
         for (k, &u) in numbers.iter().enumerate() {
-            let u = match (MisPick::of(self.share, u), &self.diffuse) {
-                (MisPick::Bsdf(u), Some(diffuse)) => {
-                    let toward = Toward::new(diffuse_direction(&diffuse.frame, u));
-                    lanes.put::<SOURCES>(k, &toward, Source::Unknown);
-                    continue;
-                }
-                (MisPick::Bsdf(u), None) => {
+            let u = match MisPick::of(self.share, u) {
+                MisPick::Bsdf(u) => {
                     (bsdf_numbers[bsdf_draws], bsdf_slots[bsdf_draws]) = (u, k);
                     bsdf_draws += 1;
                     continue;
                 }
-                (MisPick::Light(u), _) => u,
+                MisPick::Light(u) => u,
             };
             match at.lights.begin_sample(&at.receiver, u) {
                 Draw::Environment(u) => environment.push(k, u),
