@@ -8,7 +8,9 @@
 //! - traces the rays in order of direction. A pixel's rays start from nearby points, so
 //!   rays of neighbouring directions mostly meet the same surfaces: the blocker that
 //!   stopped one ([`RecentBlockers`]) is tried first for the next, and usually stops it
-//!   too. A gather's own rays, spread over a hemisphere, rarely share a blocker;
+//!   too. A gather's own rays, spread over a hemisphere, rarely share a blocker. Where
+//!   the pool last found most of its rays free (an open sky), the sort would cost more
+//!   than it saves, and the rays are traced in the order left;
 //! - adds what each free candidate brings to its sample's value, the map's lookups sixteen
 //!   at a time: one by one these cost some 29 ns, in lanes some 8 ns each.
 //!
@@ -37,7 +39,16 @@ pub struct PixelPool {
     order: Vec<u32>,
     /// Each candidate's cell of direction, found once for both passes of the sort.
     cells: Vec<u16>,
+    /// The share of the rays found blocked when the pool was last resolved (`None`: not
+    /// yet resolved).
+    blocked_share: Option<f32>,
 }
+
+/// The share of blocked rays above which the pool sorts its rays by direction. The sort
+/// pays through the blocked rays (the blocker of one stops the next), and costs every ray
+/// its place in the sort: measured with AIS off, it lost 3–9% where 13% of the rays were
+/// blocked (an open sky) and gained 9–11% where 60% were (a courtyard).
+const SORTS_ABOVE_BLOCKED: f32 = 0.25;
 
 /// What a candidate whose ray is left in the pool brings if the ray is free.
 #[derive(Clone, Copy, Debug)]
@@ -150,15 +161,32 @@ impl PixelPool {
         self.left.clear();
     }
 
-    /// Traces the rays in order of direction, each tried first against what blocked the
-    /// rays just before it, and notes which are blocked.
+    /// Traces the rays, each tried first against what blocked the rays just before it, and
+    /// notes which are blocked: in order of direction where the pool last found at least
+    /// [`SORTS_ABOVE_BLOCKED`] of its rays blocked (or has not been resolved yet), else in
+    /// the order left.
     fn trace(&mut self, geometry: &Geometry) {
-        self.sort_by_direction();
         let mut blockers = RecentBlockers::default();
-        for &i in &self.order {
-            let left = &mut self.left[i as usize];
+        let mut blocked = 0;
+        let mut trace = |left: &mut Left| {
             left.blocked = geometry.occluded_after(&left.ray, &mut blockers);
+            blocked += left.blocked as usize;
+        };
+        if self.sorts() {
+            self.sort_by_direction();
+            self.order
+                .iter()
+                .for_each(|&i| trace(&mut self.left[i as usize]));
+        } else {
+            self.left.iter_mut().for_each(trace);
         }
+        self.blocked_share = Some(blocked as f32 / self.left.len() as f32);
+    }
+
+    /// Whether the rays are traced in order of direction ([`PixelPool::trace`]).
+    fn sorts(&self) -> bool {
+        self.blocked_share
+            .is_none_or(|share| share >= SORTS_ABOVE_BLOCKED)
     }
 
     /// Puts the indices of the candidates in `order`, by direction: a counting sort over
@@ -240,6 +268,7 @@ fn direction_cell(direction: Vec3) -> usize {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::{ShapeGeometry, ShapeInput, Sphere};
     use ais::rng::Pcg32;
 
     #[test]
@@ -276,6 +305,41 @@ mod tests {
             distinct > 200,
             "directions spread over the cells: {distinct}"
         );
+    }
+
+    /// A pool sorts its rays until it finds most of them free, and again once it finds
+    /// many blocked; either way every free ray's value is added, and no blocked one's.
+    #[test]
+    fn a_pool_sorts_its_rays_where_many_were_blocked() {
+        let sphere = Sphere {
+            center: Vec3::new(0.0, 0.0, 5.0),
+            radius: 1.0,
+        };
+        let geometry = Geometry::build(vec![ShapeInput {
+            geometry: ShapeGeometry::Sphere(sphere),
+            flip_normals: false,
+            rotation: None,
+        }]);
+        let mut pool = PixelPool::default();
+        let resolve = |pool: &mut PixelPool, values: &mut [[f32; 3]], toward: Vec3, rays| {
+            pool.open();
+            for k in 0..rays {
+                let wobble = Vec3::new(k as f32 * 1e-3, 0.0, 0.0);
+                let ray = Ray::new(Vec3::ZERO, (toward + wobble).normalize());
+                pool.leave(ray, Brings::Value(Vec3::ONE), 0.5);
+            }
+            pool.resolve(&geometry, None, values);
+        };
+        let mut values = [[0.0; 3]; 1];
+        assert!(pool.sorts(), "a new pool sorts");
+        resolve(&mut pool, &mut values, -Vec3::Z, 40);
+        assert!(!pool.sorts(), "all its rays were free");
+        assert_eq!(values[0], [20.0; 3]);
+        resolve(&mut pool, &mut values, Vec3::Z, 40);
+        assert!(pool.sorts(), "all its rays were blocked");
+        assert_eq!(values[0], [20.0; 3]);
+        resolve(&mut pool, &mut values, -Vec3::Z, 10);
+        assert_eq!(values[0], [25.0; 3]);
     }
 
     #[test]
