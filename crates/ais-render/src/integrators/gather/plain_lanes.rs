@@ -36,8 +36,10 @@ pub(super) struct PlainLanes<'a> {
     /// Whether there are lights besides the environment: without them, every candidate
     /// meets the environment, and no shaft bounds any ray.
     sources: bool,
-    /// A single diffuse material, whose draws and numbers are worked out here (other BSDFs
-    /// are asked for theirs).
+    /// A single diffuse material, whose numbers are worked out here (other BSDFs are asked
+    /// for theirs; every BSDF's draws are the run's, [`GatherPoint::draw_bsdf_run`]).
+    ///
+    /// [`GatherPoint::draw_bsdf_run`]: super::strategy::GatherPoint::draw_bsdf_run
     diffuse: Option<DiffuseHit>,
     /// Whether the shadow rays that no shaft bounds are left to the pixel's pool.
     defers: bool,
