@@ -44,7 +44,7 @@ pub struct PixelPool {
     blocked_share: Option<f32>,
 }
 
-/// The share of blocked rays above which the pool sorts its rays by direction. The sort
+/// The share of blocked rays from which on the pool sorts its rays by direction. The sort
 /// pays through the blocked rays (the blocker of one stops the next), and costs every ray
 /// its place in the sort: measured with AIS off, it lost 3–9% where 13% of the rays were
 /// blocked (an open sky) and gained 9–11% where 60% were (a courtyard).
@@ -168,7 +168,7 @@ impl PixelPool {
     fn trace(&mut self, geometry: &Geometry) {
         let mut blockers = RecentBlockers::default();
         let mut blocked = 0;
-        let mut trace = |left: &mut Left| {
+        let mut trace_one = |left: &mut Left| {
             left.blocked = geometry.occluded_after(&left.ray, &mut blockers);
             blocked += left.blocked as usize;
         };
@@ -176,9 +176,9 @@ impl PixelPool {
             self.sort_by_direction();
             self.order
                 .iter()
-                .for_each(|&i| trace(&mut self.left[i as usize]));
+                .for_each(|&i| trace_one(&mut self.left[i as usize]));
         } else {
-            self.left.iter_mut().for_each(trace);
+            self.left.iter_mut().for_each(trace_one);
         }
         self.blocked_share = Some(blocked as f32 / self.left.len() as f32);
     }
