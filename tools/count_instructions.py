@@ -104,8 +104,9 @@ def functions(out):
         instructions = int(found.group(1).replace(",", ""))
         name = found.group(3).strip()
         own[name] = own.get(name, 0) + instructions
-    if total is None:
-        sys.exit(f"count_instructions: no total in callgrind_annotate's output for {out}")
+    if not total:
+        sys.exit(f"count_instructions: nothing was counted: no function matched {COUNTED} "
+                 "(renamed? update COUNTED)")
     return total, own
 
 
