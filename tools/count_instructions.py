@@ -4,7 +4,7 @@ unlike a clock on a shared 2-core host, does not move from one run to the next.
 
     python3 tools/count_instructions.py scenes/open.xml [default] [more] \\
         [--ais BINARY [--ais OTHER]] [--size 32x32] [--spp 16] [--rays 16] [--top 12] \\
-        [--time ROUNDS] [-- --ais off]
+        [--time ROUNDS] [--groups] [-- --ais off]
 
 Only the work of the pixels is counted (`pixel_radiance`, every camera sample's gather
 and the pixel's pool, and `Film::splat`), not loading, and it is divided by the camera
@@ -12,7 +12,9 @@ samples. With two binaries, each scene's line gives old over new (above 1: NEW r
 fewer instructions). With `--time ROUNDS`, each binary also renders the same frame
 ROUNDS times outside Valgrind (one thread), and the fastest render time ("render time",
 loading excluded) gives the nanoseconds a camera sample takes and the instructions run
-per nanosecond. Everything after `--` is passed to every render.
+per nanosecond. With `--groups`, a last table sums the functions' counts by the stage of
+a camera sample they belong to (`GROUPS`). Everything after `--` is passed to every
+render.
 
 Valgrind does not know AVX-512, so the binaries must be built for a CPU without it; the
 default binary is such a build, with line tables, brought up to date on every run:
@@ -36,6 +38,25 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_BINARY = os.path.join(ROOT, "target", "callgrind", "release", "ais")
 # The functions whose instructions are counted, with everything they call.
 COUNTED = ["*SampleIntegrator>::pixel_radiance", "ais_render::film::Film::splat"]
+# The stages of a camera sample, each with the parts of the function names that go to it
+# (the first group that matches takes a function; inlined code counts where it is inlined).
+GROUPS = [
+    ("shadow rays", ["occluded_after", "blocking_distance", "Packed::intersect",
+                     "occluded_aiming", "shaft", "Shaft::", "RecentBlockers"]),
+    ("camera ray, first hit", ["Geometry::intersect", "PixelRays::fill", "frame_for",
+                               "attribute_site", "camera::"]),
+    ("light draws and light hits", ["EnvironmentDraws", "invert_guided", "AreaDraws",
+                                    "sample_run", "sample_toward", "spherical_rectangle",
+                                    "rectangles_along", "write_source", "all_missed",
+                                    "AreaLight", "sources_along", "alias", "mesh_emitter",
+                                    "acos", "atan2"]),
+    ("the plain lanes", ["PlainLanes", "draw_bsdf_run", "weighed"]),
+    ("the pool and map lookups", ["pixel_radiance", "look_up_lanes", "interpolate"]),
+    ("a gather's set-up", ["run_plain", "rescramble", "halton", "gather::gather",
+                           "gather_point", "run_batch", "try_from_fn", "get_or_insert",
+                           "memset", "memcpy"]),
+    ("the film", ["Film::splat"]),
+]
 RENDER_TIME = re.compile(r"^render time\s+([0-9.]+) s", re.MULTILINE)
 # A line of `callgrind_annotate`: the count, then `file:function [object]`.
 ANNOTATED = re.compile(r"^\s*([0-9,]+)\s+(?:\([^)]*\)\s+)?(\S+?):(.+?)(?: \[.*\])?$")
@@ -110,6 +131,27 @@ def functions(out):
     return total, own
 
 
+def grouped(own):
+    """`own`'s counts summed by `GROUPS`, and what no group took under "the rest"."""
+    sums = {name: 0 for name, _ in GROUPS + [("the rest", [])]}
+    for function, instructions in own.items():
+        group = next((name for name, parts in GROUPS if any(p in function for p in parts)),
+                     "the rest")
+        sums[group] += instructions
+    return sums
+
+
+def print_groups(rows, samples):
+    """The `--groups` table: per render, each group's instructions per camera sample."""
+    names = [name for name, _ in GROUPS] + ["the rest"]
+    print("\n| render | " + " | ".join(names) + " |")
+    print("|---|" + "---|" * len(names))
+    for label, sums in rows:
+        total = sum(sums.values())
+        cells = (f"{sums[n] / samples:,.0f} ({sums[n] / total:.0%})" for n in names)
+        print(f"| {label} | " + " | ".join(cells) + " |")
+
+
 def camera_samples(args):
     width, height = (int(v) for v in args.size.split("x"))
     return width * height * args.spp
@@ -128,6 +170,8 @@ def parse_args():
     parser.add_argument("--top", type=int, default=12, help="functions listed per render")
     parser.add_argument("--time", type=int, default=0, metavar="ROUNDS",
                         help="also time ROUNDS renders outside Valgrind")
+    parser.add_argument("--groups", action="store_true",
+                        help="also sum the counts by stage of a camera sample")
     args = parser.parse_args(argv)
     args.extra = extra
     if not re.fullmatch(r"[1-9][0-9]*x[1-9][0-9]*", args.size):
@@ -149,6 +193,7 @@ def main():
         if not os.path.exists(binary):
             sys.exit(f"count_instructions: {binary} not found")
     samples = camera_samples(args)
+    rows = []
     for scene in args.scenes:
         per_sample = []
         for binary in binaries:
@@ -162,10 +207,13 @@ def main():
                          f"{fastest * 1e9 / samples:,.0f} ns per camera sample, "
                          f"{total / (fastest * 1e9):.2f} instructions per ns")
             print(line)
+            rows.append((f"{scene} ({os.path.basename(binary)})", grouped(own)))
             for name, instructions in sorted(own.items(), key=lambda kv: -kv[1])[:args.top]:
                 print(f"  {instructions / samples:8,.0f}  {instructions / total:6.1%}  {name[:110]}")
         if len(per_sample) == 2:
             print(f"{scene}: old / new = {per_sample[0] / per_sample[1]:.4f}")
+    if args.groups:
+        print_groups(rows, samples)
 
 
 if __name__ == "__main__":
