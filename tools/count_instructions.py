@@ -34,6 +34,10 @@ import subprocess
 import sys
 import tempfile
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The same render, on one thread, as the builds' comparison times it.
+from compare_builds import RENDER_TIME, render_command  # noqa: E402
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_BINARY = os.path.join(ROOT, "target", "callgrind", "release", "ais")
 # The functions whose instructions are counted, with everything they call.
@@ -57,7 +61,6 @@ GROUPS = [
                            "memset", "memcpy"]),
     ("the film", ["Film::splat"]),
 ]
-RENDER_TIME = re.compile(r"^render time\s+([0-9.]+) s", re.MULTILINE)
 # A line of `callgrind_annotate`: the count, then `file:function [object]`.
 ANNOTATED = re.compile(r"^\s*([0-9,]+)\s+(?:\([^)]*\)\s+)?(\S+?):(.+?)(?: \[.*\])?$")
 
@@ -69,15 +72,6 @@ def build_default():
                CARGO_TARGET_DIR=os.path.join(ROOT, "target", "callgrind"))
     print("building ais without AVX-512 for Valgrind (target/callgrind)", file=sys.stderr)
     subprocess.run(["cargo", "build", "--release", "-p", "ais-cli"], cwd=ROOT, env=env, check=True)
-
-
-def render_command(binary, scene, args, folder):
-    """The command that renders `scene` with `binary` on one thread into `folder`."""
-    command = [binary, "render"] + ([] if scene == "default" else [scene])
-    command += ["--rays", str(args.rays), "--resolution", args.size, "--spp", str(args.spp),
-                "--threads", "1", "--seed", "1", "--no-preview", "-q",
-                "-o", os.path.join(folder, "out.exr")]
-    return command + args.extra
 
 
 def run(command, binary, scene):
@@ -94,7 +88,8 @@ def count(binary, scene, args, folder):
     out = os.path.join(folder, "callgrind.out")
     command = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}"]
     command += [f"--toggle-collect={name}" for name in COUNTED]
-    run(command + render_command(binary, scene, args, folder), binary, scene)
+    output = os.path.join(folder, "out.exr")
+    run(command + render_command(binary, scene, args, output), binary, scene)
     return out
 
 
@@ -102,7 +97,8 @@ def fastest_time(binary, scene, args, folder):
     """The fastest of `args.time` render times of `binary` on `scene`, in seconds."""
     times = []
     for _ in range(args.time):
-        printed = run(render_command(binary, scene, args, folder), binary, scene)
+        command = render_command(binary, scene, args, os.path.join(folder, "out.exr"))
+        printed = run(command, binary, scene)
         found = RENDER_TIME.search(printed)
         if not found:
             sys.exit(f"count_instructions: no render time in {binary}'s output on {scene}")
