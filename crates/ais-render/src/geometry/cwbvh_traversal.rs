@@ -65,19 +65,34 @@ impl LanedBvh {
         ground.may_meet(ray).then(|| ground.group())
     }
 
+    /// Whether `ray` passes by the box around the BVH's primitives (it may still meet the
+    /// ground).
+    #[inline(always)]
+    pub(super) fn passes_box(&self, ray: &Ray) -> bool {
+        self.outer.passed_by(ray, ray.t_max)
+    }
+
+    /// Whether `ray` may meet the ground (not when there is none).
+    #[inline(always)]
+    pub(super) fn may_meet_ground(&self, ray: &Ray) -> bool {
+        (self.ground.as_ref()).is_some_and(|ground| ground.may_meet(ray))
+    }
+
     /// The primitive that blocks `ray` before its end, if any (the first found, not the
-    /// nearest). `blocks(index, t_max)` answers for the primitives that are not triangles.
+    /// nearest). `blocks(index, t_max)` answers for the primitives that are not triangles;
+    /// `passes_box` is [`LanedBvh::passes_box`], where already known.
     pub(super) fn blocker(
         &self,
         ray: &Ray,
         mut blocks: impl FnMut(usize, f32) -> bool,
+        passes_box: Option<bool>,
     ) -> Option<usize> {
         if let Some((base, group)) = self.ground_group(ray) {
             if let Some(index) = self.lanes.any_hit(base, group, ray, ray.t_max) {
                 return Some(index);
             }
         }
-        if self.outer.passed_by(ray, ray.t_max) {
+        if passes_box.unwrap_or_else(|| self.passes_box(ray)) {
             return None;
         }
         let bvh_ray = ray.to_bvh(ray.t_max);

@@ -535,6 +535,18 @@ impl Geometry {
         match &self.accelerator {
             None => false,
             Some(Accelerator::Cwbvh(bvh)) => {
+                // A ray that passes everything by is free, known before a blocker's test
+                // (where the gather's rays mostly do).
+                let mut passes_box = None;
+                if blockers.tries_box_first() {
+                    let passes = bvh.passes_box(ray);
+                    blockers.box_tried(passes);
+                    if passes && !bvh.may_meet_ground(ray) {
+                        blockers.note_free();
+                        return false;
+                    }
+                    passes_box = Some(passes);
+                }
                 let blocks = |index, t_max| self.blocking_distance(index, ray, t_max) < t_max;
                 let tried = blockers.how_many_to_try();
                 for at in 0..tried {
@@ -544,7 +556,7 @@ impl Geometry {
                     }
                 }
                 blockers.missed(tried);
-                let blocker = bvh.blocker(ray, blocks);
+                let blocker = bvh.blocker(ray, blocks, passes_box);
                 match blocker {
                     Some(index) => blockers.remember(index, bvh.near_test(index)),
                     None => blockers.note_free(),

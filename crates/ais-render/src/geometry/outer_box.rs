@@ -2,7 +2,10 @@
 //! most shadow rays pass by every object, and a traversal pays for setting up and for the
 //! root's eight children (decoded from 8-bit offsets) to learn that; one exact box test
 //! learns it for less. Rays that start among the objects (a room's) always enter the box,
-//! which six comparisons of their origin show.
+//! which six comparisons of their origin show. Where a gather's rays mostly pass the box
+//! by, it is tried before the blockers its earlier rays met, too
+//! ([`super::RecentBlockers::tries_box_first`]): a ray that passes everything by needs no
+//! blocker's test.
 
 use super::ray::Ray;
 use glam::Vec3A;

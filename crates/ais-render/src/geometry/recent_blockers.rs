@@ -23,6 +23,10 @@ pub struct RecentBlockers {
     /// The gather's rays that were blocked, and those that were free.
     blocked: u32,
     free: u32,
+    /// The gather's rays tested against the box around everything first that passed it by,
+    /// and that did not.
+    box_passed: u32,
+    box_entered: u32,
 }
 
 /// A primitive that blocked a ray.
@@ -65,8 +69,24 @@ impl RecentBlockers {
         RecentBlockers {
             blocked: 0,
             free: 0,
+            box_passed: 0,
+            box_entered: 0,
             ..*self
         }
+    }
+
+    /// Whether the next ray is tested against the box around everything first, before
+    /// the blockers: while the box has been passed by about as many of the gather's rays as
+    /// not (under an open sky most rays pass it by, and need no blocker's test; in a room
+    /// none do).
+    pub(super) fn tries_box_first(&self) -> bool {
+        self.box_entered <= self.box_passed + 1
+    }
+
+    /// A ray tested against the box first passed it by, or not.
+    pub(super) fn box_tried(&mut self, passed: bool) {
+        self.box_passed += passed as u32;
+        self.box_entered += !passed as u32;
     }
 
     /// A ray was found free (by a traversal, or without one: a shaft's answer).
@@ -209,5 +229,32 @@ mod tests {
         // A ray blocked by a blocker tried first counts as blocked too.
         blockers.blocked_by(0);
         assert_eq!(blockers.passed_on().len, 2);
+    }
+
+    #[test]
+    fn the_box_is_tried_first_while_about_as_many_rays_pass_it_as_enter_it() {
+        let mut blockers = RecentBlockers::default();
+        assert!(blockers.tries_box_first(), "a gather's first ray");
+        blockers.box_tried(false);
+        assert!(blockers.tries_box_first(), "one entered, none passed");
+        blockers.box_tried(false);
+        assert!(
+            !blockers.tries_box_first(),
+            "two entered, none passed (a room)"
+        );
+        blockers.box_tried(true);
+        assert!(blockers.tries_box_first(), "two entered, one passed");
+        for _ in 0..5 {
+            blockers.box_tried(true);
+        }
+        // Six passed: up to seven entered.
+        for _ in 2..8 {
+            assert!(blockers.tries_box_first(), "under an open sky");
+            blockers.box_tried(false);
+        }
+        assert!(!blockers.tries_box_first());
+        // The next gather counts its own rays afresh.
+        remember(&mut blockers, 0);
+        assert!(blockers.passed_on().tries_box_first());
     }
 }
