@@ -78,7 +78,8 @@ impl RecentBlockers {
     /// Whether the next ray is tested against the box around everything first, before
     /// the blockers: while the box has been passed by about as many of the gather's rays as
     /// not (under an open sky most rays pass it by, and need no blocker's test; in a room
-    /// none do).
+    /// none do). Once it stops, the box is tried only after the blockers, before a
+    /// traversal, for the rest of the gather's rays ([`super::Geometry::occluded_after`]).
     pub(super) fn tries_box_first(&self) -> bool {
         self.box_entered <= self.box_passed + 1
     }
@@ -242,6 +243,7 @@ mod tests {
             !blockers.tries_box_first(),
             "two entered, none passed (a room)"
         );
+        // (The renderer tries no more boxes first then; the rule alone, counted on.)
         blockers.box_tried(true);
         assert!(blockers.tries_box_first(), "two entered, one passed");
         for _ in 0..5 {
