@@ -23,7 +23,7 @@ pub use instances::{InstanceInput, SceneShapes, ShapeGroupInput};
 use primitive::Packed;
 pub use primitive::{Primitive, Sphere, Triangle};
 pub use quadric::{Quadric, QuadricKind, QuadricSample, QuadricSurface};
-pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray};
+pub use ray::{offset_origin, spawn_ray, spawn_ray_to, Ray, RayOrigins};
 pub use recent_blockers::RecentBlockers;
 pub use shaft::{LeavingSurface, Shaft};
 

@@ -3,7 +3,7 @@
 
 use super::shared_origin::SharedOrigin;
 use super::strategy::GatherPoint;
-use crate::geometry::{spawn_ray, spawn_ray_to, Ray, RecentBlockers};
+use crate::geometry::{Ray, RayOrigins, RecentBlockers};
 use crate::lights::{Aim, Toward};
 use crate::render::RayCounts;
 use crate::world::World;
@@ -51,16 +51,16 @@ impl Leaving {
     }
 }
 
-/// The shadow ray leaving `at` along `direction`, free up to `target` if given.
+/// The origins of the shadow rays leaving `at`.
+#[inline]
+pub(super) fn ray_origins(at: &GatherPoint) -> RayOrigins {
+    RayOrigins::new(at.receiver.point, at.frame.geometric)
+}
+
+/// The shadow ray leaving `at` along `direction`, free up to `target` if given
+/// ([`RayOrigins::aimed`]).
 pub(super) fn shadow_ray(at: &GatherPoint, direction: Vec3, target: Option<Vec3>) -> Ray {
-    let (point, normal) = (at.receiver.point, at.frame.geometric);
-    // Aimed at the light's point from the offset origin, so that the ray ends just short of
-    // it whatever the offset (a ray along the direction from the offset origin can meet a
-    // curved light well before the point, near its rim).
-    match target {
-        Some(target) => spawn_ray_to(point, normal, target),
-        None => spawn_ray(point, normal, direction),
-    }
+    ray_origins(at).aimed(direction, target)
 }
 
 /// What a candidate's shadow ray found ([`free_radiance`]).

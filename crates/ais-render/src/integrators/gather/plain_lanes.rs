@@ -8,7 +8,7 @@
 //! [`Toward`]: crate::lights::Toward
 
 use super::batch_loop::{BatchRun, PlainSum};
-use super::light::shadow_ray;
+use super::light::{ray_origins, shadow_ray};
 use super::pixel_pool::{Brings, SkyLookup};
 use super::shared_origin::SharedOrigin;
 use super::strategy::{MisParts, MisPick, Strategy};
@@ -242,6 +242,12 @@ impl<'a> PlainLanes<'a> {
     ) {
         let mut origin = run.shared_origin();
         let mut lanes = Lanes::default();
+        let origins = ray_origins(run.at);
+        // Borrowed once for the batch: nothing else reaches the pool while it runs.
+        let mut pool = run
+            .pixel_pool
+            .filter(|_| DEFERS)
+            .map(|pool| pool.borrow_mut());
         for numbers in numbers.chunks(RUN) {
             let count = numbers.len();
             self.draw::<SOURCES>(run, numbers, &mut lanes);
@@ -256,12 +262,12 @@ impl<'a> PlainLanes<'a> {
             // gather's spread counts it), and so does one left to the pixel's pool.
             for k in (0..count).filter(|&k| lanes.kept[k]) {
                 total.add(
-                    match (lanes.free[k], DEFERS && lanes.deferred[k], run.pixel_pool) {
+                    match (lanes.free[k], DEFERS && lanes.deferred[k], pool.as_mut()) {
                         (false, ..) => Vec3::ZERO,
                         (true, true, Some(pool)) => {
-                            let ray = shadow_ray(run.at, lanes.direction[k], lanes.target_of(k));
+                            let ray = origins.aimed(lanes.direction[k], lanes.target_of(k));
                             let brings = self.brings::<SOURCES>(run, &lanes, k);
-                            pool.borrow_mut().leave(ray, brings, 1.0 / run.rays as f32);
+                            pool.leave(ray, brings, 1.0 / run.rays as f32);
                             Vec3::ZERO
                         }
                         (true, ..) => self.brought::<SOURCES>(run, &lanes, k),
