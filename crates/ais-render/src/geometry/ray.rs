@@ -97,9 +97,7 @@ impl RayOrigins {
             t_max: distance * (1.0 - 1e-4),
         }
     }
-}
 
-impl RayOrigins {
     /// A shadow ray along `direction`, free up to `target` if given. Aimed at the target
     /// from the offset origin, so that the ray ends just short of it whatever the offset
     /// (a ray along the direction from the offset origin can meet a curved light well
